@@ -1,0 +1,90 @@
+"""gift: Generalizing Intent for Flexible Test-time rewards.
+
+Lookup of registered components::
+
+    import gift
+    kernel = gift.get_kernel("language")
+    gift.list_components()            # {"kernel": [...], "simulator": [...], ...}
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from gift.core.data import (
+    DISTRACTOR,
+    Alignment,
+    Appearance,
+    Completion,
+    DemonstrationPair,
+    FeatureBatch,
+    FeatureSpec,
+    FeatureTrace,
+    Intent,
+    Message,
+    Motivation,
+    ObjectSpec,
+    Scene,
+    SemanticAxis,
+    Trajectory,
+    TrajectoryBatch,
+    Usage,
+)
+from gift.core.errors import GiftError, LMAnswerError, LMError, PluginError, SuiteError, UnknownComponentError
+from gift.core.pipeline import GiftPipeline
+from gift.core.suite import Suite, load_suite
+from gift.plugins.hookspecs import hookimpl
+from gift.plugins.manager import get_manager
+
+__version__ = "0.1.0"
+
+
+def get_component(kind: str, name: str, **options: Any) -> Any:
+    """Build the registered component ``name`` of ``kind`` with ``options``."""
+    return get_manager().create(kind, name, **options)
+
+
+def get_simulator(name: str, **options: Any):
+    return get_component("simulator", name, **options)
+
+
+def get_task(name: str, **options: Any):
+    return get_component("task", name, **options)
+
+
+def get_kernel(name: str, **options: Any):
+    return get_component("kernel", name, **options)
+
+
+def get_intent_estimator(name: str, **options: Any):
+    return get_component("intent_estimator", name, **options)
+
+
+def get_alignment_operator(name: str, **options: Any):
+    return get_component("alignment_operator", name, **options)
+
+
+def get_reward_model(name: str, **options: Any):
+    return get_component("reward_model", name, **options)
+
+
+def get_lm(name: str, **options: Any):
+    return get_component("lm_backend", name, **options)
+
+
+def list_components(kind: str | None = None) -> dict[str, list[dict[str, str]]]:
+    """Every registered component by kind: ``{kind: [{name, plugin, distribution, description}]}``."""
+    out: dict[str, list[dict[str, str]]] = {}
+    for c in get_manager().components(kind):
+        out.setdefault(c.kind, []).append(c.as_dict())
+    return out
+
+
+__all__ = [
+    "DISTRACTOR", "Alignment", "Appearance", "Completion", "DemonstrationPair", "FeatureBatch", "FeatureSpec",
+    "FeatureTrace", "Intent", "Message", "Motivation", "ObjectSpec", "Scene", "SemanticAxis", "Trajectory",
+    "TrajectoryBatch", "Usage", "GiftError", "LMAnswerError", "LMError", "PluginError", "SuiteError",
+    "UnknownComponentError", "GiftPipeline", "Suite", "load_suite", "hookimpl", "get_manager", "get_component",
+    "get_simulator", "get_task", "get_kernel", "get_intent_estimator", "get_alignment_operator",
+    "get_reward_model", "get_lm", "list_components",
+]

@@ -1,0 +1,182 @@
+"""Abstract interfaces of gift: one class per concept of the paper.
+
+=========================================  ============================================
+Paper                                      Code
+=========================================  ============================================
+ω̂ = J(D_H, D_¬H)                           :meth:`IntentEstimator.estimate`
+K(s, s' | ω) ∈ [0, 1]                      :meth:`SimilarityKernel.similarity` -> [n_test, n_train]
+f_ω(s') = argmax_s K(s, s' | ω)            :meth:`AlignmentOperator.align`
+f_ω(ξ') (semantic components only)         :func:`gift.core.alignment.align_features`
+R_θ(ξ)                                     :meth:`RewardModel.score`
+R̃_θ(ξ' | ω) = R_θ(f_ω(ξ'))                 :meth:`RewardModel.score_aligned`
+=========================================  ============================================
+
+Every method is batch-first: it takes many trajectories (or objects) per call.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from gift.core.data import (
+    Alignment,
+    Completion,
+    DemonstrationPair,
+    FeatureBatch,
+    FeatureSpec,
+    Intent,
+    Message,
+    ObjectSpec,
+    Scene,
+    TrajectoryBatch,
+)
+
+
+class Task(abc.ABC):
+    """A task family: its landmarks, its features, and its ground-truth reward.
+
+    A family is simulator-independent and works for any object names and relevance labels.
+    """
+
+    name: ClassVar[str]
+    description: ClassVar[str] = ""
+    #: Landmarks of the family (e.g. ``("backpack",)``), present in every scene.
+    landmarks: ClassVar[tuple[str, ...]] = ()
+
+    @abc.abstractmethod
+    def feature_specs(self, objects: Sequence[str]) -> tuple[FeatureSpec, ...]:
+        """The feature columns of a scene holding ``objects`` (semantic ones first)."""
+
+    @abc.abstractmethod
+    def ground_truth_reward(self, features: FeatureBatch, relevant: Sequence[str]) -> np.ndarray:
+        """The human's true reward of N trajectories: ``[N]``, given the relevant object names."""
+
+    def context(self) -> str:
+        """One sentence about the task for the LM prompts (what the robot does)."""
+        return self.description
+
+
+class Simulator(abc.ABC):
+    """Builds scenes, generates trajectories, computes features and renders objects."""
+
+    name: ClassVar[str]
+    #: Degrees of freedom of the robot.
+    dof: ClassVar[int] = 7
+    #: Number of states per trajectory.
+    n_steps: ClassVar[int] = 61
+
+    @abc.abstractmethod
+    def make_scene(self, task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str],
+                   seed: int) -> Scene:
+        """A randomised scene of family ``task`` (start, goal and placements from ``seed``)."""
+
+    @abc.abstractmethod
+    def generate(self, scene: Scene, generator: str, n: int, seed: int) -> TrajectoryBatch:
+        """``n`` trajectories in ``scene``; ``generator`` is ``"preferred"`` or ``"default"``."""
+
+    @abc.abstractmethod
+    def features(self, trajectories: TrajectoryBatch, task: str) -> FeatureBatch:
+        """Per-time-step features ``[N, T, F]`` of the family ``task``."""
+
+    def render_object(self, obj: ObjectSpec, size: int = 224) -> np.ndarray:
+        """Images of one object from three viewpoints: ``[3, size, size, 3]`` uint8 RGB."""
+        raise NotImplementedError(f"simulator {self.name!r} cannot render")
+
+
+class LMBackend(abc.ABC):
+    """A language model. Every LM call of gift goes through :meth:`complete`."""
+
+    name: ClassVar[str]
+    #: True when :meth:`choice_probabilities` is available (needs token log-probabilities).
+    supports_choice_probabilities: ClassVar[bool] = False
+    #: The model identifier (a path, a hub name, a provider/model string).
+    model: str = ""
+
+    @abc.abstractmethod
+    def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
+                 max_tokens: int = 512, stop: Sequence[str] | None = None,
+                 json_schema: Mapping[str, Any] | None = None) -> Completion:
+        """Answer a chat. ``json_schema`` asks backends that can constrain decoding to emit such JSON."""
+
+    def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
+        """P(answer = c) for each short answer ``c``, renormalised over ``choices``."""
+        raise NotImplementedError(f"LM backend {self.name!r} has no log-probabilities; "
+                                  f"use a backend with supports_choice_probabilities=True (llamacpp, transformers)")
+
+    def identity(self) -> str:
+        """Stable identity for caches: backend name and model."""
+        return f"{self.name}:{self.model}"
+
+
+class IntentEstimator(abc.ABC):
+    """J(D_H, D_¬H): infers the intent behind preferred-vs-default demonstrations."""
+
+    name: ClassVar[str]
+
+    @abc.abstractmethod
+    def estimate(self, demonstrations: Sequence[DemonstrationPair], *, task_context: str = "",
+                 objects: Sequence[str] = ()) -> Intent:
+        """The inferred intent (with motivations and semantic axes over ``objects``)."""
+
+
+class SimilarityKernel(abc.ABC):
+    """K(s, s' | ω) on the semantic components of states: object-to-object similarity."""
+
+    name: ClassVar[str]
+    #: True when the kernel reads the intent (GIFT); False for surface kernels (vision, language).
+    uses_intent: ClassVar[bool] = False
+
+    @abc.abstractmethod
+    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                   intent: Intent | None = None) -> np.ndarray:
+        """K as a matrix ``[n_test, n_train]`` with values in [0, 1]."""
+
+
+class AlignmentOperator(abc.ABC):
+    """f_ω(s') = argmax_s K(s, s' | ω), or DISTRACTOR when nothing is similar enough."""
+
+    name: ClassVar[str]
+
+    @abc.abstractmethod
+    def align(self, kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+              intent: Intent | None = None, *, relevant_train: Sequence[str] = ()) -> Alignment:
+        """Map every test object to a training object or DISTRACTOR."""
+
+
+class RewardModel(abc.ABC):
+    """R_θ(ξ), learned once from demonstrations; scores batches of trajectories."""
+
+    name: ClassVar[str]
+
+    @property
+    @abc.abstractmethod
+    def feature_specs(self) -> tuple[FeatureSpec, ...]:
+        """The training feature columns the reward reads."""
+
+    @abc.abstractmethod
+    def fit(self, demonstrations: FeatureBatch, alternatives: FeatureBatch) -> "RewardModel":
+        """Learn θ so that ``demonstrations`` are likely against ``alternatives`` (MaxEnt IRL)."""
+
+    @abc.abstractmethod
+    def score(self, features: FeatureBatch) -> np.ndarray:
+        """R_θ(ξ) for N trajectories: ``[N]``. Columns are matched by feature name."""
+
+    def score_aligned(self, features: FeatureBatch, alignment: Alignment) -> np.ndarray:
+        """R̃_θ(ξ' | ω) = R_θ(f_ω(ξ')) for N test trajectories: ``[N]``."""
+        from gift.core.alignment import align_features
+
+        return self.score(align_features(features, alignment, self.feature_specs))
+
+    @abc.abstractmethod
+    def save(self, path: str | Path) -> None:
+        """Write weights, feature names and metadata."""
+
+    @classmethod
+    @abc.abstractmethod
+    def load(cls, path: str | Path) -> "RewardModel":
+        """Read what :meth:`save` wrote."""

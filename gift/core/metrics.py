@@ -1,0 +1,131 @@
+"""Evaluation metrics: pairwise win rate, Boltzmann choice, alignment F1/FP/FN, AUC."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import attrs
+import numpy as np
+
+
+def pairwise_win_rate(predicted: np.ndarray, true: np.ndarray, pairs: np.ndarray | None = None) -> float:
+    """Accuracy of predicting which trajectory of each pair the human prefers.
+
+    ``predicted``, ``true``: rewards ``[N]``; ``pairs``: ``[P, 2]`` indices (default: all pairs).
+    A correct order counts 1, a predicted tie 0.5; pairs the human is indifferent about are skipped.
+    """
+    predicted = np.asarray(predicted, dtype=float)
+    true = np.asarray(true, dtype=float)
+    if pairs is None:
+        i, j = np.triu_indices(len(true), k=1)
+    else:
+        pairs = np.asarray(pairs, dtype=np.intp)
+        i, j = pairs[:, 0], pairs[:, 1]
+    t = np.sign(true[i] - true[j])
+    p = np.sign(predicted[i] - predicted[j])
+    keep = t != 0
+    if not keep.any():
+        raise ValueError("pairwise_win_rate: the true rewards tie on every pair")
+    t, p = t[keep], p[keep]
+    return float(np.mean(np.where(p == 0, 0.5, (p == t).astype(float))))
+
+
+def sample_pairs(n: int, n_pairs: int, rng: np.random.Generator) -> np.ndarray:
+    """``[n_pairs, 2]`` distinct index pairs drawn uniformly from ``range(n)``."""
+    i = rng.integers(0, n, size=n_pairs)
+    j = (i + rng.integers(1, n, size=n_pairs)) % n
+    return np.stack([i, j], axis=1)
+
+
+def mean_se(values: Sequence[float]) -> tuple[float, float]:
+    """Mean and standard error of the mean (0 for a single value)."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 0:
+        return float("nan"), float("nan")
+    se = float(v.std(ddof=1) / np.sqrt(v.size)) if v.size > 1 else 0.0
+    return float(v.mean()), se
+
+
+def boltzmann(rewards: np.ndarray, beta: float = 1.0) -> np.ndarray:
+    """P(ξ_k) ∝ exp(β R(ξ_k)) over the last axis of ``rewards`` ``[..., K]``."""
+    z = beta * np.asarray(rewards, dtype=float)
+    z = z - z.max(axis=-1, keepdims=True)
+    e = np.exp(z)
+    return e / e.sum(axis=-1, keepdims=True)
+
+
+@attrs.frozen
+class BinaryMetrics:
+    tp: int
+    fp: int
+    tn: int
+    fn: int
+
+    @property
+    def precision(self) -> float:
+        return self.tp / (self.tp + self.fp) if self.tp + self.fp else 0.0
+
+    @property
+    def recall(self) -> float:
+        return self.tp / (self.tp + self.fn) if self.tp + self.fn else 0.0
+
+    @property
+    def f1(self) -> float:
+        d = 2 * self.tp + self.fp + self.fn
+        return 2 * self.tp / d if d else 0.0
+
+    @property
+    def fp_rate(self) -> float:
+        """FP as a fraction of the negatives (the paper's FP %)."""
+        return self.fp / (self.fp + self.tn) if self.fp + self.tn else 0.0
+
+    @property
+    def fn_rate(self) -> float:
+        """FN as a fraction of the positives (the paper's FN %)."""
+        return self.fn / (self.fn + self.tp) if self.fn + self.tp else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        return {"tp": self.tp, "fp": self.fp, "tn": self.tn, "fn": self.fn, "precision": self.precision,
+                "recall": self.recall, "f1": self.f1, "fp_rate": self.fp_rate, "fn_rate": self.fn_rate}
+
+
+def binary_metrics(predicted: Sequence[bool], truth: Sequence[bool]) -> BinaryMetrics:
+    p = np.asarray(predicted, dtype=bool)
+    t = np.asarray(truth, dtype=bool)
+    if p.shape != t.shape:
+        raise ValueError(f"binary_metrics: {p.shape} predictions for {t.shape} labels")
+    return BinaryMetrics(tp=int((p & t).sum()), fp=int((p & ~t).sum()), tn=int((~p & ~t).sum()),
+                         fn=int((~p & t).sum()))
+
+
+def roc_auc(scores: Sequence[float], labels: Sequence[bool]) -> float:
+    """Probability that a random positive scores above a random negative (ties count 1/2)."""
+    s = np.asarray(scores, dtype=float)
+    y = np.asarray(labels, dtype=bool)
+    pos, neg = s[y], s[~y]
+    if pos.size == 0 or neg.size == 0:
+        return float("nan")
+    diff = pos[:, None] - neg[None, :]
+    return float(((diff > 0).sum() + 0.5 * (diff == 0).sum()) / diff.size)
+
+
+def best_f1_threshold(scores: Sequence[float], labels: Sequence[bool]) -> float:
+    """The cut (``score >= cut`` is positive) that maximises F1 on these labels: the oracle threshold."""
+    s = np.asarray(scores, dtype=float)
+    y = np.asarray(labels, dtype=bool)
+    cands = np.unique(s)
+    best, best_f1 = float(cands[0]) if cands.size else 0.5, -1.0
+    for c in cands:
+        f1 = binary_metrics(s >= c, y).f1
+        if f1 > best_f1:
+            best, best_f1 = float(c), f1
+    return best
+
+
+def cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cosine similarity matrix of row vectors: ``[n, d] x [m, d] -> [n, m]``."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    a = a / np.maximum(np.linalg.norm(a, axis=-1, keepdims=True), 1e-12)
+    b = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 1e-12)
+    return a @ b.T

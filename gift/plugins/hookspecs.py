@@ -1,0 +1,90 @@
+"""The hooks a gift plugin implements.
+
+A plugin is a module (or object) with functions decorated by :data:`gift.hookimpl`, exposed through
+an entry point in the group ``gift``::
+
+    # pyproject.toml of a third-party package
+    [project.entry-points.gift]
+    my_kernel = "my_package.plugin"
+
+    # my_package/plugin.py
+    import gift
+
+    @gift.hookimpl
+    def gift_register_kernels(register):
+        register("my-kernel", MyKernel, description="cosine of my embeddings")
+
+Every hook receives a ``register(name, factory, *, description="")`` callable. ``factory`` builds the
+component (a class or any callable); ``gift.get_kernel("my-kernel", **options)`` calls
+``factory(**options)``. Two plugins registering the same name for the same kind is an error naming both.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+import pluggy
+
+hookspec = pluggy.HookspecMarker("gift")
+hookimpl = pluggy.HookimplMarker("gift")
+
+
+class Register(Protocol):
+    """The ``register`` callable handed to every hook."""
+
+    def __call__(self, name: str, factory: Any, *, description: str = "") -> None: ...
+
+
+class RegisterCommand(Protocol):
+    """``register(name, run, *, help="", configure=None)`` for CLI subcommands.
+
+    ``configure(parser)`` adds arguments to an :class:`argparse.ArgumentParser`; ``run(args)`` executes
+    the command and returns an exit code (or None for 0).
+    """
+
+    def __call__(self, name: str, run: Any, *, help: str = "", configure: Any = None) -> None: ...
+
+
+@hookspec
+def gift_register_simulators(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.Simulator` factories (e.g. ``drake-franka``)."""
+
+
+@hookspec
+def gift_register_tasks(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.Task` factories (task families such as ``pack_backpack``)."""
+
+
+@hookspec
+def gift_register_kernels(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.SimilarityKernel` factories (``language``, ``gift``, ...)."""
+
+
+@hookspec
+def gift_register_intent_estimators(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.IntentEstimator` factories (``lm-contrastive``, ...)."""
+
+
+@hookspec
+def gift_register_alignment_operators(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.AlignmentOperator` factories."""
+
+
+@hookspec
+def gift_register_reward_models(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.RewardModel` factories (``maxent-linear``, ...)."""
+
+
+@hookspec
+def gift_register_lm_backends(register: Register) -> None:
+    """Register :class:`gift.core.interfaces.LMBackend` factories (``llamacpp``, ``litellm``, ...)."""
+
+
+@hookspec
+def gift_register_suites(register: Register) -> None:
+    """Register benchmark suites: ``register(name, path_to_yaml)``."""
+
+
+@hookspec
+def gift_register_commands(register: RegisterCommand) -> None:
+    """Register ``gift`` CLI subcommands."""

@@ -1,0 +1,207 @@
+"""Plugin discovery (entry-point group ``gift``), the component registry, and lookup by name.
+
+Environment variables:
+
+- ``GIFT_PLUGINS``: comma-separated allow-list of entry-point names; only these are loaded
+  (built-in plugins always load). Unset or empty: load every installed plugin.
+- ``GIFT_DISABLE_PLUGINS``: comma-separated entry-point names never to load.
+
+A plugin that fails to import (or whose hook raises) is skipped with a warning naming it; everything
+else keeps working.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.metadata
+import os
+import threading
+import warnings
+from collections.abc import Callable, Iterable
+from typing import Any
+
+import attrs
+import pluggy
+
+from gift.core.errors import PluginError, UnknownComponentError
+from gift.plugins import hookspecs
+
+ENTRY_POINT_GROUP = "gift"
+
+#: kind -> hook that registers it.
+KINDS: dict[str, str] = {
+    "simulator": "gift_register_simulators",
+    "task": "gift_register_tasks",
+    "kernel": "gift_register_kernels",
+    "intent_estimator": "gift_register_intent_estimators",
+    "alignment_operator": "gift_register_alignment_operators",
+    "reward_model": "gift_register_reward_models",
+    "lm_backend": "gift_register_lm_backends",
+    "suite": "gift_register_suites",
+    "command": "gift_register_commands",
+}
+
+BUILTIN_PLUGINS = ("gift.tasks", "gift.suites")
+
+
+class PluginWarning(UserWarning):
+    """A plugin could not be loaded or registered; it was skipped."""
+
+
+@attrs.frozen
+class Component:
+    """One registered component. ``factory(**options)`` builds it."""
+
+    kind: str
+    name: str
+    factory: Any
+    plugin: str
+    distribution: str
+    description: str = ""
+    extra: dict = attrs.field(factory=dict)
+
+    def create(self, **options: Any) -> Any:
+        return self.factory(**options)
+
+    def as_dict(self) -> dict[str, str]:
+        return {"kind": self.kind, "name": self.name, "plugin": self.plugin, "distribution": self.distribution,
+                "description": self.description}
+
+
+def _env_list(var: str) -> set[str] | None:
+    raw = os.environ.get(var, "").strip()
+    return {x.strip() for x in raw.split(",") if x.strip()} if raw else None
+
+
+class GiftPluginManager:
+    """Loads plugins, collects their registrations and answers lookups."""
+
+    def __init__(self) -> None:
+        self.pm = pluggy.PluginManager("gift")
+        self.pm.add_hookspecs(hookspecs)
+        self._registry: dict[str, dict[str, Component]] = {k: {} for k in KINDS}
+        self._distribution: dict[str, str] = {}
+        self.failed: dict[str, str] = {}
+        self._loaded = False
+
+    # -------------------------------------------------------------------- loading
+    def register_plugin(self, plugin: Any, name: str, distribution: str = "gift") -> None:
+        """Register a plugin object or module directly (as tests and embedding code do)."""
+        self.pm.register(plugin, name=name)
+        self._distribution[name] = distribution
+        if self._loaded:
+            self._collect_from(name)
+
+    def load(self, entry_points: Iterable[importlib.metadata.EntryPoint] | None = None) -> "GiftPluginManager":
+        if self._loaded:
+            return self
+        for mod in BUILTIN_PLUGINS:
+            self.register_plugin(importlib.import_module(mod), name=mod, distribution="gift")
+        allow = _env_list("GIFT_PLUGINS")
+        deny = _env_list("GIFT_DISABLE_PLUGINS") or set()
+        eps = entry_points if entry_points is not None else importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)
+        for ep in sorted(eps, key=lambda e: e.name):
+            if (allow is not None and ep.name not in allow) or ep.name in deny:
+                continue
+            if self.pm.has_plugin(ep.name):
+                continue
+            dist = ep.dist.name if getattr(ep, "dist", None) is not None else "?"
+            try:
+                plugin = ep.load()
+            except Exception as e:  # noqa: BLE001 - any import failure of a third-party plugin
+                self.failed[ep.name] = f"{type(e).__name__}: {e}"
+                warnings.warn(f"gift plugin {ep.name!r} (distribution {dist!r}, {ep.value}) failed to import and "
+                              f"was skipped: {type(e).__name__}: {e}", PluginWarning, stacklevel=2)
+                continue
+            self.pm.register(plugin, name=ep.name)
+            self._distribution[ep.name] = dist
+        self._loaded = True
+        for name, _ in self.pm.list_name_plugin():
+            self._collect_from(name)
+        return self
+
+    def _collect_from(self, plugin_name: str) -> None:
+        plugin = self.pm.get_plugin(plugin_name)
+        for kind, hook_name in KINDS.items():
+            hook = getattr(self.pm.hook, hook_name)
+            for impl in hook.get_hookimpls():
+                if impl.plugin is not plugin:
+                    continue
+                try:
+                    impl.function(register=self._registrar(kind, plugin_name))
+                except PluginError:
+                    raise
+                except Exception as e:  # noqa: BLE001
+                    self.failed[plugin_name] = f"{hook_name}: {type(e).__name__}: {e}"
+                    warnings.warn(f"gift plugin {plugin_name!r}: hook {hook_name} raised {type(e).__name__}: {e}; "
+                                  f"its remaining registrations were skipped", PluginWarning, stacklevel=2)
+
+    def _registrar(self, kind: str, plugin_name: str) -> Callable[..., None]:
+        dist = self._distribution.get(plugin_name, "?")
+
+        def register(name: str, factory: Any, *, description: str = "", help: str = "", **extra: Any) -> None:
+            description = description or help
+            if not isinstance(name, str) or not name.strip():
+                raise PluginError(f"plugin {plugin_name!r} registered a {kind} with an invalid name {name!r}")
+            if factory is None:
+                raise PluginError(f"plugin {plugin_name!r} registered {kind} {name!r} without a factory")
+            existing = self._registry[kind].get(name)
+            if existing is not None:
+                raise PluginError(f"two plugins register the {kind} {name!r}: {existing.plugin!r} (distribution "
+                                  f"{existing.distribution!r}) and {plugin_name!r} (distribution {dist!r}); "
+                                  f"uninstall one or disable it with GIFT_DISABLE_PLUGINS")
+            if not description and kind not in ("suite",):
+                doc = getattr(factory, "__doc__", None) or ""
+                description = doc.strip().splitlines()[0] if doc.strip() else ""
+            self._registry[kind][name] = Component(kind, name, factory, plugin_name, dist, description, extra)
+
+        return register
+
+    # -------------------------------------------------------------------- lookup
+    def components(self, kind: str | None = None) -> list[Component]:
+        kinds = [kind] if kind else list(KINDS)
+        return [c for k in kinds for c in sorted(self._registry[self._kind(k)].values(), key=lambda c: c.name)]
+
+    def names(self, kind: str) -> list[str]:
+        return sorted(self._registry[self._kind(kind)])
+
+    def get(self, kind: str, name: str) -> Component:
+        kind = self._kind(kind)
+        try:
+            return self._registry[kind][name]
+        except KeyError:
+            known = ", ".join(sorted(self._registry[kind])) or "none"
+            hint = f" (plugins that failed to load: {sorted(self.failed)})" if self.failed else ""
+            raise UnknownComponentError(f"no {kind} named {name!r}; registered: {known}{hint}") from None
+
+    def create(self, kind: str, name: str, **options: Any) -> Any:
+        return self.get(kind, name).create(**options)
+
+    def suites(self) -> dict[str, str]:
+        return {c.name: str(c.factory) for c in self._registry["suite"].values()}
+
+    @staticmethod
+    def _kind(kind: str) -> str:
+        if kind not in KINDS:
+            raise PluginError(f"unknown component kind {kind!r}; kinds: {sorted(KINDS)}")
+        return kind
+
+
+_manager: GiftPluginManager | None = None
+_lock = threading.Lock()
+
+
+def get_manager() -> GiftPluginManager:
+    """The process-wide plugin manager, loaded on first use."""
+    global _manager
+    with _lock:
+        if _manager is None:
+            _manager = GiftPluginManager().load()
+        return _manager
+
+
+def reset_manager() -> None:
+    """Forget the loaded plugins (the next lookup discovers them again)."""
+    global _manager
+    with _lock:
+        _manager = None

@@ -1,0 +1,1 @@
+"""gift_kernels plugin for gift."""

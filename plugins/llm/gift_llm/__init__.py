@@ -1,0 +1,1 @@
+"""gift_llm plugin for gift."""

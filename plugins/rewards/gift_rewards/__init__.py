@@ -1,0 +1,1 @@
+"""gift_rewards plugin for gift."""

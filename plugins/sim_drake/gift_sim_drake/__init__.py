@@ -1,0 +1,1 @@
+"""gift_sim_drake plugin for gift."""

@@ -1,0 +1,3 @@
+"""Entry point of gift_sim_drake: registers its components with gift."""
+
+from gift.plugins.hookspecs import hookimpl  # noqa: F401  (hooks are added as components land)

