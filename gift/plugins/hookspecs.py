@@ -81,6 +81,11 @@ def gift_register_lm_backends(register: Register) -> None:
 
 
 @hookspec
+def gift_register_executors(register: Register) -> None:
+    """Register :class:`gift.core.executor.Executor` factories (``local``, ``ray``, ...)."""
+
+
+@hookspec
 def gift_register_suites(register: Register) -> None:
     """Register benchmark suites: ``register(name, path_to_yaml)``."""
 

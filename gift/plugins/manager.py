@@ -37,6 +37,7 @@ KINDS: dict[str, str] = {
     "alignment_operator": "gift_register_alignment_operators",
     "reward_model": "gift_register_reward_models",
     "lm_backend": "gift_register_lm_backends",
+    "executor": "gift_register_executors",
     "suite": "gift_register_suites",
     "command": "gift_register_commands",
 }
