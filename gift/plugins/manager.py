@@ -42,7 +42,7 @@ KINDS: dict[str, str] = {
     "command": "gift_register_commands",
 }
 
-BUILTIN_PLUGINS = ("gift.tasks", "gift.suites")
+BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors")
 
 
 class PluginWarning(UserWarning):
