@@ -19,8 +19,7 @@ from typing import Any
 import numpy as np
 
 KERNEL_ORDER = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
-SUBSETS = ("R", "lang", "vis", "unk", "conf", "all")
-SUBSET_LABEL = {"R": "S_R", "lang": "S_lang", "vis": "S_vis", "unk": "S_unk", "conf": "S_conf", "all": "S_R ∪ S_conf"}
+SUBSET_LABEL = {"R": "S_R", "lang": "S_lang", "vis": "S_vis", "unk": "S_unk", "all": "S_R ∪ S_conf"}
 
 
 def _kernels(block: dict[str, dict]) -> list[str]:

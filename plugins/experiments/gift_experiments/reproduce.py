@@ -28,10 +28,10 @@ import attrs
 import numpy as np
 
 import gift
-from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatch, Intent, ObjectSpec, Scene
+from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatch, Intent, Scene
 from gift.core.errors import GiftError
-from gift.core.metrics import binary_metrics, boltzmann, mean_se, pairwise_win_rate, roc_auc, sample_pairs
-from gift.core.suite import CONFOUNDS, IntentSpec, Suite
+from gift.core.metrics import boltzmann, mean_se, pairwise_win_rate, sample_pairs
+from gift.core.suite import IntentSpec, Suite
 
 GENERIC_INTENT = "The human prefers to move objects around the table."
 ALL_KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
@@ -198,10 +198,6 @@ def test_scene(comp: Components, suite: Suite, spec: IntentSpec, robot: str, see
 # ----------------------------------------------------------------------------- intents
 
 
-def ground_truth_intent(spec: IntentSpec) -> Intent:
-    return Intent(text=spec.text, source="ground-truth")
-
-
 def infer_intent(comp: Components, spec: IntentSpec, pairs: Sequence[DemonstrationPair], seed: int = 0,
                  temperature: float = 0.0) -> Intent:
     task = gift.get_task(spec.task)
@@ -225,9 +221,9 @@ def intent_from_json(d: dict) -> Intent:
 
 def text_cosine(a: Sequence[str], b: str) -> np.ndarray:
     """MiniLM cosine of each sentence in ``a`` with ``b`` (raw cosine in [-1, 1])."""
-    kernel = gift.get_kernel("language")
-    emb = kernel.embed(list(a) + [b])
-    emb = emb / np.linalg.norm(emb, axis=1, keepdims=True)
+    from gift_kernels.language import embed_texts
+
+    emb = embed_texts(list(a) + [b])  # unit-norm rows
     return emb[:-1] @ emb[-1]
 
 
@@ -240,36 +236,28 @@ def oracle_alignment(spec: IntentSpec) -> Alignment:
     return Alignment(mapping, {k: 1.0 if v != DISTRACTOR else 0.0 for k, v in mapping.items()}, kernel=ORACLE)
 
 
-def align_all(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: str, intent: Intent | None,
-              threshold: str) -> tuple[Alignment, dict[str, float]]:
-    """Alignment of every test object of the intent, and each test object's relevance score."""
+def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: str, intent: Intent | None,
+                 thresholds: Sequence[str]) -> dict[str, dict]:
+    """Run one kernel once on the intent's test objects; per threshold: the alignment and its metrics.
+
+    Returns ``{threshold: {"cut", "note", "mapping", "scores", "metrics": {subset: {...}}}}``.
+    """
+    from gift_kernels.alignment import score_alignment
+    from gift_kernels.evaluation import REPORT_SUBSETS, _members, subset_metrics
+
     kernel = comp.kernel(kernel_name)
-    op = gift.get_alignment_operator("argmax-threshold", threshold=threshold)
-    test = suite.specs(spec.test_objects)
-    train = suite.specs(spec.train_objects)
-    labels = [t.relevant for t in spec.test] if threshold == "oracle" else None
-    kwargs = {"labels": labels} if labels is not None else {}
-    al = op.align(kernel, test, train, intent if kernel.uses_intent else None,
-                  relevant_train=spec.relevant_train, **kwargs)
-    scores = op.relevance_scores(kernel, test, train, intent if kernel.uses_intent else None,
-                                 relevant_train=spec.relevant_train)
-    return al, {o.name: float(s) for o, s in zip(test, scores)}
-
-
-def alignment_metrics(spec: IntentSpec, al: Alignment, scores: dict[str, float]) -> dict[str, dict]:
-    """Per subset (R, lang, vis, unk, conf, all): F1, FP, FN, AUC, counts."""
-    predicted = al.relevant(spec.relevant_train)
-    subsets = {"R": spec.subset("R")}
-    subsets.update({c: spec.subset(c) for c in CONFOUNDS})
-    subsets["conf"] = tuple(t for t in spec.test if t.confounds)
-    subsets["all"] = spec.test
+    scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                             intent if kernel.uses_intent else None, relevant_train=spec.relevant_train,
+                             need=tuple(thresholds))
+    labels = {t.object: t.relevant for t in spec.test}
+    y = np.array([t.relevant for t in spec.test], dtype=bool)
     out = {}
-    for name, items in subsets.items():
-        if not items:
-            continue
-        m = binary_metrics([predicted[t.object] for t in items], [t.relevant for t in items])
-        out[name] = {**m.as_dict(), "n": len(items),
-                     "auc": roc_auc([scores[t.object] for t in items], [t.relevant for t in items])}
+    for th in thresholds:
+        cut, note = scores.threshold(th, labels)
+        al = scores.alignment(cut)
+        out[th] = {"cut": cut, "note": note, "mapping": dict(al.mapping), "scores": dict(al.scores),
+                   "metrics": {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)], cut)
+                               for sub in REPORT_SUBSETS if _members(spec, sub).any()}}
     return out
 
 
@@ -316,28 +304,26 @@ def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: 
                 results["sanity"][spec.id] = {"inferred": list(mean_se(cos_inf)),
                                               "generic": [float(cos_gen[0]), 0.0], "texts": texts}
         else:
+            from gift_kernels.evaluation import ground_truth_intent
+
             intent = ground_truth_intent(spec)
         results["intents"][spec.id] = intent_to_json(intent)
 
-        # ---- alignments (once per kernel and threshold; independent of the number of trajectories)
+        # ---- alignments (once per kernel; independent of the number of trajectories)
         aligned: dict[str, dict[str, tuple[Alignment, dict]]] = {}
         for kname in progress(cfg.kernels, f"{spec.id}: kernels"):
-            for th in cfg.thresholds:
-                def _al(kname=kname, th=th):
-                    al, sc = align_all(comp, suite, spec, kname, intent, th)
-                    return {"mapping": dict(al.mapping), "scores": dict(al.scores), "threshold": al.threshold,
-                            "relevance": sc}
-
-                try:
-                    d = timed(f"align {kname}", lambda: cache.get_or_compute(f"align-{spec.id}-{kname}-{th}", _al))
-                except Exception as e:  # keep what the other kernels computed
-                    log(f"[{spec.id}] kernel {kname} ({th}) failed: {type(e).__name__}: {e}")
-                    results.setdefault("errors", []).append(f"{spec.id}/{kname}/{th}: {type(e).__name__}: {e}")
-                    continue
-                al = Alignment(d["mapping"], d["scores"], d["threshold"], kernel=kname)
-                aligned.setdefault(kname, {})[th] = (al, d["relevance"])
-                results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = alignment_metrics(
-                    spec, al, d["relevance"])
+            try:
+                d = timed(f"align {kname}", lambda: cache.get_or_compute(
+                    f"align-{spec.id}-{kname}", lambda: align_kernel(comp, suite, spec, kname, intent,
+                                                                     cfg.thresholds)))
+            except Exception as e:  # noqa: BLE001 - keep what the other kernels computed
+                log(f"[{spec.id}] kernel {kname} failed: {type(e).__name__}: {e}")
+                results.setdefault("errors", []).append(f"{spec.id}/{kname}: {type(e).__name__}: {e}")
+                continue
+            for th, r in d.items():
+                aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
+                                                     r["metrics"])
+                results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
         oracle = oracle_alignment(spec)
 
         # ---- RQ1
