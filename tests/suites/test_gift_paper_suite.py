@@ -1,0 +1,254 @@
+"""The shipped ``gift-paper`` suite: it loads by name and its data keeps the benchmark's promises.
+
+These check the data itself (catalog, splits, subset sizes, sibling intents, look-alikes), the things a
+strict loader cannot know. No simulator is involved.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from difflib import SequenceMatcher
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gift
+from gift.core.data import slug
+from gift.core.suite import CONFOUNDS, load_suite_file
+from gift.plugins.manager import get_manager
+
+SUITE = "gift-paper"
+
+#: The paper's six ground-truth intents: suite id -> (task family, intent text).
+PAPER_INTENTS = {
+    "mug_water_sensitive": ("place_mug", "avoid carrying fluids near water-sensitive objects"),
+    "spill_paper": ("sweep_spill", "sweep paper-based items away from the spill"),
+    "pack_art_supplies": ("pack_backpack", "pack art supplies"),
+    "pack_reading_material": ("pack_backpack", "pack reading material"),
+    "store_valuables": ("store_drawer", "store valuables"),
+    "store_electronics": ("store_drawer", "store electronics"),
+}
+SIBLINGS = [("pack_art_supplies", "pack_reading_material"), ("store_valuables", "store_electronics")]
+CONFOUNDED = [i for pair in SIBLINGS for i in pair]
+
+#: Every object the paper names.
+PAPER_OBJECTS = [
+    "paintbrush", "sketchbook", "canvas", "molding clay", "tablet with stylus", "toothbrush", "broomstick",
+    "dish scrubber", "pepper grinder", "watercolor", "easel", "metal paintbrush", "wooden pencil", "screwdriver",
+    "diamond ring", "paper ring", "MacBook Pro", "iPad Pro", "iPhone Pro", "desk clock", "hand sanitizer",
+    "coffee mug", "laptop",
+]
+
+#: Words that would hand a description-reading kernel the labels.
+LABEL_WORDS = re.compile(r"valuabl|art[- ]suppl|reading[- ]material|electronic|paper[- ]based|water[- ]sensitiv",
+                         re.IGNORECASE)
+
+MAX_EXTENT_M = 0.45
+
+
+@pytest.fixture(scope="module")
+def suite():
+    return gift.load_suite(SUITE)
+
+
+def labels(intent) -> dict[str, bool]:
+    """Object name -> relevant, over the intent's training and test objects."""
+    out = {o: o in intent.relevant_train for o in intent.train_objects}
+    out.update({t.object: t.relevant for t in intent.test})
+    return out
+
+
+def extent(app) -> float:
+    """Largest dimension of an appearance in metres."""
+    if app.shape == "box":
+        return max(app.size)
+    if app.shape == "cylinder":
+        return max(2 * app.size[0], app.size[1])
+    return 2 * app.size[0]
+
+
+def looks_alike(a, b) -> bool:
+    """Same primitive, overall size within 2x, proportions within 2x, colour within 0.2 (RGB distance)."""
+    if a.shape != b.shape:
+        return False
+    sa, sb = np.array(a.size), np.array(b.size)
+    if a.shape == "box":  # orientation does not matter
+        sa, sb = np.sort(sa)[::-1], np.sort(sb)[::-1]
+    ea, eb = extent(a), extent(b)
+    if max(ea, eb) / min(ea, eb) > 2.0:
+        return False
+    ratio = (sa / ea) / (sb / eb)
+    if np.any(ratio > 2.0) or np.any(ratio < 0.5):
+        return False
+    return float(np.linalg.norm(np.subtract(a.color, b.color))) <= 0.2
+
+
+def names_alike(a: str, b: str) -> bool:
+    """Share a word, or a common run of at least four letters (toothbrush ~ paintbrush)."""
+    wa, wb = set(re.findall(r"[a-z0-9]+", a.lower())), set(re.findall(r"[a-z0-9]+", b.lower()))
+    if wa & wb:
+        return True
+    m = SequenceMatcher(None, a.lower(), b.lower()).find_longest_match(0, len(a), 0, len(b))
+    return m.size >= 4
+
+
+# ----------------------------------------------------------------------------- loading
+
+
+def test_suite_loads_by_name_and_by_path(suite):
+    assert suite.name == SUITE
+    assert SUITE in get_manager().suites()
+    path = Path(suite.path)
+    assert path.name == "gift-paper.yaml" and path.parent.name == "suites"
+    again = load_suite_file(path, known_tasks=get_manager().names("task"))
+    assert again.objects == suite.objects and again.intents == suite.intents
+    assert suite.description.strip()
+
+
+def test_the_six_paper_intents_on_registered_tasks(suite):
+    assert {i.id: (i.task, i.text) for i in suite.intents} == PAPER_INTENTS
+    registered = set(get_manager().names("task"))
+    assert {i.task for i in suite.intents} <= registered
+    for i in suite.intents:
+        assert i.notes.strip(), f"{i.id}: the label rule belongs in notes"
+
+
+# ----------------------------------------------------------------------------- catalog
+
+
+def test_catalog_has_sixty_objects_including_every_one_the_paper_names(suite):
+    assert len(suite.objects) >= 60
+    missing = [o for o in PAPER_OBJECTS if o not in suite.objects]
+    assert not missing, f"paper objects missing from the catalog: {missing}"
+
+
+def test_every_object_referenced_is_in_the_catalog_and_every_catalog_object_is_used(suite):
+    used = set()
+    for i in suite.intents:
+        names = set(i.train_objects) | set(i.relevant_train) | set(i.test_objects)
+        assert names <= set(suite.objects), f"{i.id}: {sorted(names - set(suite.objects))}"
+        used |= names
+    assert not set(suite.objects) - used, f"catalog objects no intent uses: {sorted(set(suite.objects) - used)}"
+
+
+def test_descriptions_are_single_neutral_lines(suite):
+    for name, spec in suite.objects.items():
+        d = spec.description
+        assert d.strip() and "\n" not in d and len(d) <= 160, f"{name}: {d!r}"
+        assert not LABEL_WORDS.search(d), f"{name}: description gives a label away: {d!r}"
+
+
+def test_feature_names_stay_unique(suite):
+    """Object names map to distinct feature slugs, none of which collides with a task landmark."""
+    slugs = [slug(n) for n in suite.objects]
+    assert len(set(slugs)) == len(slugs)
+    landmarks = {lm for t in get_manager().names("task") for lm in get_manager().create("task", t).landmarks}
+    assert not set(slugs) & landmarks
+
+
+def test_appearances_fit_the_table_and_are_all_distinct(suite):
+    for name, spec in suite.objects.items():
+        assert extent(spec.appearance) <= MAX_EXTENT_M, f"{name} is {extent(spec.appearance)} m across"
+    for (a, sa), (b, sb) in itertools.combinations(suite.objects.items(), 2):
+        assert sa.appearance != sb.appearance, f"{a} and {b} have identical appearances"
+
+
+# ----------------------------------------------------------------------------- splits and labels
+
+
+@pytest.mark.parametrize("intent_id", sorted(PAPER_INTENTS))
+def test_split_sizes_and_disjointness(suite, intent_id):
+    i = suite.intent(intent_id)
+    assert 4 <= len(i.train_objects) <= 6
+    assert 2 <= len(i.relevant_train) <= 3 and len(i.relevant_train) < len(i.train_objects)
+    assert 14 <= len(i.test) <= 24
+    assert not set(i.train_objects) & set(i.test_objects), "train and test must be disjoint"
+    assert len(set(i.test_objects)) == len(i.test_objects)
+
+
+@pytest.mark.parametrize("intent_id", sorted(PAPER_INTENTS))
+def test_every_intent_has_positives_and_negatives_in_s_r(suite, intent_id):
+    i = suite.intent(intent_id)
+    s_r = i.subset("R")
+    assert any(t.relevant for t in s_r) and any(not t.relevant for t in s_r)
+    assert any(t.relevant for t in i.test) and any(not t.relevant for t in i.test)
+
+
+@pytest.mark.parametrize("intent_id", CONFOUNDED)
+def test_confound_subsets_meet_their_minimum(suite, intent_id):
+    i = suite.intent(intent_id)
+    sizes = {c: len(i.subset(c)) for c in CONFOUNDS}
+    assert all(n >= 4 for n in sizes.values()), sizes
+
+
+@pytest.mark.parametrize("intent_id", ["mug_water_sensitive", "spill_paper"])
+def test_place_and_sweep_are_s_r_only(suite, intent_id):
+    i = suite.intent(intent_id)
+    assert i.subset("R") == i.test
+
+
+@pytest.mark.parametrize("a,b", SIBLINGS)
+def test_sibling_intents_share_training_scenes_but_not_relevance(suite, a, b):
+    ia, ib = suite.intent(a), suite.intent(b)
+    assert ia.task == ib.task
+    assert ia.train_objects == ib.train_objects
+    assert not set(ia.relevant_train) & set(ib.relevant_train)
+
+
+@pytest.mark.parametrize("a,b", SIBLINGS)
+def test_sibling_intents_disagree_on_their_s_unk_items(suite, a, b):
+    ia, ib = suite.intent(a), suite.intent(b)
+    unk_a = {t.object: t.relevant for t in ia.subset("unk")}
+    unk_b = {t.object: t.relevant for t in ib.subset("unk")}
+    assert set(unk_a) == set(unk_b)
+    for obj, rel in unk_a.items():
+        assert unk_b[obj] is (not rel), f"{obj}: {a}={rel}, {b}={unk_b[obj]}"
+    # both labels occur, so S_unk tests false positives and false negatives alike
+    assert set(unk_a.values()) == {True, False}
+
+
+# ----------------------------------------------------------------------------- confounds are real confounds
+
+
+@pytest.mark.parametrize("intent_id", CONFOUNDED)
+def test_visual_confounds_look_like_an_object_of_the_opposite_label(suite, intent_id):
+    i = suite.intent(intent_id)
+    lab = labels(i)
+    for t in i.subset("vis"):
+        app = suite.objects[t.object].appearance
+        twins = [o for o, r in lab.items() if r != t.relevant and looks_alike(app, suite.objects[o].appearance)]
+        assert twins, f"{intent_id}: {t.object!r} looks like nothing labelled {not t.relevant}"
+
+
+@pytest.mark.parametrize("intent_id", CONFOUNDED)
+def test_language_confounds_are_named_like_an_object_of_the_opposite_label(suite, intent_id):
+    i = suite.intent(intent_id)
+    lab = labels(i)
+    for t in i.subset("lang"):
+        twins = [o for o, r in lab.items() if r != t.relevant and names_alike(t.object, o)]
+        assert twins, f"{intent_id}: {t.object!r} is named like nothing labelled {not t.relevant}"
+
+
+def test_paper_examples_keep_their_roles(suite):
+    """The confounds the paper discusses are in the subsets it puts them in, with its labels."""
+    art, val = suite.intent("pack_art_supplies"), suite.intent("store_valuables")
+    item = {t.object: t for t in art.test} | {t.object: t for t in val.test}
+    assert "paintbrush" in art.relevant_train and "diamond ring" in val.relevant_train
+    assert "lang" in item["toothbrush"].confounds and not item["toothbrush"].relevant
+    assert "vis" in item["broomstick"].confounds and not item["broomstick"].relevant
+    assert "vis" in item["dish scrubber"].confounds and not item["dish scrubber"].relevant
+    assert item["molding clay"].relevant and item["tablet with stylus"].relevant
+    assert {"lang", "vis"} <= set(item["paper ring"].confounds) and not item["paper ring"].relevant
+    assert item["MacBook Pro"].relevant and item["iPad Pro"].relevant and item["iPhone Pro"].relevant
+    assert "unk" in item["metal paintbrush"].confounds and "unk" in item["wooden pencil"].confounds
+
+
+def test_look_alike_check_is_not_vacuous(suite):
+    """The helpers above reject obviously different pairs, so passing them means something."""
+    objs = suite.objects
+    assert looks_alike(objs["broomstick"].appearance, objs["paintbrush"].appearance)
+    assert not looks_alike(objs["molding clay"].appearance, objs["paintbrush"].appearance)
+    assert not looks_alike(objs["apple"].appearance, objs["tennis ball"].appearance)
+    assert names_alike("toothbrush", "paintbrush") and not names_alike("molding clay", "paintbrush")
