@@ -49,6 +49,9 @@ log "gift core + plugin distributions + test tools"
 "${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake -e plugins/experiments "torch==2.13.0"
 "${PIP[@]}" pytest pytest-benchmark hypothesis "torch==2.13.0"
 
+log "docs: mkdocs (Material) + mkdocstrings"
+"${PIP[@]}" mkdocs-material "mkdocstrings[python]" "torch==2.13.0"
+
 log "assembling and verifying the embedded model"
 "$VPY" -m gift_llm.embedded install
 
