@@ -252,3 +252,34 @@ def test_look_alike_check_is_not_vacuous(suite):
     assert not looks_alike(objs["molding clay"].appearance, objs["paintbrush"].appearance)
     assert not looks_alike(objs["apple"].appearance, objs["tennis ball"].appearance)
     assert names_alike("toothbrush", "paintbrush") and not names_alike("molding clay", "paintbrush")
+
+
+# ----------------------------------------------------------------------------- the document
+
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "suites.md"
+
+
+def test_doc_example_suite_loads(tmp_path):
+    blocks = re.findall(r"```yaml\n(.*?)```", DOC.read_text(encoding="utf-8"), re.DOTALL)
+    example = [b for b in blocks if b.startswith("suite: my-lab-suite")]
+    assert len(example) == 1
+    path = tmp_path / "my-lab-suite.yaml"
+    path.write_text(example[0], encoding="utf-8")
+    s = gift.load_suite(path)
+    assert s.name == "my-lab-suite"
+    art = s.intent("art")
+    assert art.relevant_test == ("crayon box",) and [t.object for t in art.subset("lang")] == ["toothbrush"]
+
+
+def test_doc_tables_match_the_suite(suite):
+    """Every test item's row in docs/suites.md shows the suite's label and subsets."""
+    text = DOC.read_text(encoding="utf-8")
+    for i in suite.intents:
+        section = text.split(f"#### `{i.id}`", 1)[1].split("\n#### ", 1)[0].split("\n## ", 1)[0]
+        rows = {m[0]: (m[1], m[2]) for m in re.findall(r"^\| ([^|]+?) \| (yes|no) \| ([^|]+?) \|$", section, re.M)}
+        want = {t.object: ("yes" if t.relevant else "no",
+                           ", ".join(f"S_{c}" for c in t.confounds) if t.confounds else "S_R") for t in i.test}
+        assert rows == want, i.id
+        rel = ", ".join(i.relevant_train)
+        assert f"**relevant** {rel};" in section, i.id
