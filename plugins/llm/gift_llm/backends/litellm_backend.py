@@ -1,0 +1,158 @@
+"""``litellm``: any provider litellm knows (``openai/gpt-4o``, ``anthropic/...``, ``ollama/...``,
+``hosted_vllm/...``) or any OpenAI-compatible server through ``api_base``.
+
+API keys come only from the environment (litellm reads ``OPENAI_API_KEY``, ``ANTHROPIC_API_KEY``, ...;
+``api_key_env`` names another variable). They never enter cache keys, recordings, logs or error messages.
+Rate limits, timeouts, connection errors and 5xx answers are retried with exponential backoff, a bounded
+number of times; then an :class:`LMError` names the model, the URL and what happened.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import random
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+from gift.core.data import Completion, Message, Usage
+from gift.core.errors import LMError
+from gift.core.interfaces import LMBackend
+from gift_llm.backends.common import choice_variants, message_dicts, renormalise
+
+#: Providers whose chat API returns token log-probabilities (``logprobs``/``top_logprobs``).
+LOGPROB_PROVIDERS = ("openai", "hosted_vllm", "together_ai", "fireworks_ai", "deepseek")
+
+
+def _litellm() -> Any:
+    os.environ.setdefault("LITELLM_LOCAL_MODEL_COST_MAP", "True")
+    try:
+        import litellm
+    except ImportError as e:
+        raise LMError("litellm backend: the litellm package is not installed (bash scripts/setup.sh)") from e
+    litellm.suppress_debug_info = True
+    return litellm
+
+
+class LiteLLM(LMBackend):
+    """Hosted or OpenAI-compatible chat models through litellm (keys from the environment only)."""
+
+    name: ClassVar[str] = "litellm"
+    supports_choice_probabilities: ClassVar[bool] = False
+
+    def __init__(self, model: str | None = None, *, api_base: str | None = None, api_key_env: str | None = None,
+                 timeout_s: float = 120.0, max_retries: int = 4, backoff_s: float = 1.0, backoff_max_s: float = 30.0,
+                 logprobs: bool | None = None, top_logprobs: int = 20, **_ignored: Any):
+        if not model:
+            raise LMError("litellm backend: name a model, e.g. --lm litellm:openai/gpt-4o")
+        self.model = str(model)
+        self.api_base = api_base or None
+        self.api_key_env = api_key_env
+        if api_key_env and not os.environ.get(api_key_env):
+            raise LMError(f"litellm {self.model}: the environment variable {api_key_env} is not set")
+        self.timeout_s, self.max_retries = float(timeout_s), int(max_retries)
+        self.backoff_s, self.backoff_max_s = float(backoff_s), float(backoff_max_s)
+        provider = self.model.split("/", 1)[0] if "/" in self.model else "openai"
+        self.supports_choice_probabilities = (provider in LOGPROB_PROVIDERS if logprobs is None  # type: ignore[misc]
+                                              else bool(logprobs))
+        self.top_logprobs = int(top_logprobs)
+
+    def identity(self) -> str:
+        return f"{self.name}:{self.model}" + (f"@{self.api_base}" if self.api_base else "")
+
+    @property
+    def where(self) -> str:
+        return self.api_base or "the provider's default endpoint"
+
+    def _secrets(self) -> list[str]:
+        names = [self.api_key_env] if self.api_key_env else []
+        names += [k for k in os.environ if k.endswith(("_API_KEY", "_TOKEN", "_SECRET", "_KEY"))]
+        return [os.environ[k] for k in names if k and len(os.environ.get(k, "")) >= 6]
+
+    def _scrub(self, text: str) -> str:
+        for s in self._secrets():
+            text = text.replace(s, "***")
+        return text
+
+    def _call(self, **kwargs: Any) -> Any:
+        litellm = _litellm()
+        ex = litellm.exceptions
+        retryable = (ex.RateLimitError, ex.Timeout, ex.APIConnectionError, ex.ServiceUnavailableError,
+                     ex.InternalServerError, ex.BadGatewayError)
+        kwargs.update(model=self.model, drop_params=True, timeout=self.timeout_s, num_retries=0)
+        if self.api_base:
+            kwargs["api_base"] = self.api_base
+        if self.api_key_env:
+            kwargs["api_key"] = os.environ[self.api_key_env]
+        elif self.api_base and self.model.startswith(("openai/", "hosted_vllm/")) and not os.environ.get(
+                "OPENAI_API_KEY"):
+            kwargs["api_key"] = "no-key-needed"  # local OpenAI-compatible servers ignore it; the client wants one
+        attempt = 0
+        while True:
+            try:
+                return litellm.completion(**kwargs)
+            except retryable as e:
+                attempt += 1
+                if attempt > self.max_retries:
+                    raise LMError(f"litellm {self.model} at {self.where}: {type(e).__name__} after {attempt} "
+                                  f"attempts: {self._scrub(str(e))[:500]}") from None
+                delay = min(self.backoff_max_s, self.backoff_s * 2 ** (attempt - 1)) * (0.5 + random.random() / 2)
+                time.sleep(delay)
+            except Exception as e:  # noqa: BLE001 - auth, bad request, unknown model: not retryable
+                raise LMError(f"litellm {self.model} at {self.where}: {type(e).__name__}: "
+                              f"{self._scrub(str(e))[:500]}") from None
+
+    def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
+                 max_tokens: int = 512, stop: Sequence[str] | None = None,
+                 json_schema: Mapping[str, Any] | None = None) -> Completion:
+        kw: dict[str, Any] = dict(messages=message_dicts(messages), temperature=float(temperature),
+                                  max_tokens=int(max_tokens))
+        if seed is not None:
+            kw["seed"] = int(seed)
+        if stop:
+            kw["stop"] = list(stop)
+        if json_schema is not None:
+            kw["response_format"] = ({"type": "json_schema", "json_schema": {"name": "answer", "schema": json_schema}}
+                                     if json_schema.get("properties") else {"type": "json_object"})
+        t0 = time.perf_counter()
+        resp = self._call(**kw)
+        latency = time.perf_counter() - t0
+        try:
+            text = resp.choices[0].message.content or ""
+        except (AttributeError, IndexError) as e:
+            raise LMError(f"litellm {self.model} at {self.where}: malformed response: {e}") from None
+        usage = getattr(resp, "usage", None)
+        cost = None
+        try:
+            cost = float(_litellm().completion_cost(completion_response=resp))
+        except Exception:  # noqa: BLE001 - no price known for this model
+            cost = None
+        return Completion(text, Usage(prompt_tokens=int(getattr(usage, "prompt_tokens", 0) or 0),
+                                      completion_tokens=int(getattr(usage, "completion_tokens", 0) or 0),
+                                      latency_s=latency, cost_usd=cost), model=self.identity())
+
+    def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
+        """From the provider's ``top_logprobs`` of the first answer token; choices outside the top-k get 0."""
+        if not self.supports_choice_probabilities:
+            return super().choice_probabilities(messages, choices)
+        if not choices:
+            raise LMError("choice_probabilities: no choices given")
+        resp = self._call(messages=message_dicts(messages), temperature=0.0, max_tokens=1, logprobs=True,
+                          top_logprobs=self.top_logprobs)
+        try:
+            first = resp.choices[0].logprobs["content"][0] if isinstance(resp.choices[0].logprobs, dict) \
+                else resp.choices[0].logprobs.content[0]
+            tops = first["top_logprobs"] if isinstance(first, dict) else first.top_logprobs
+            pairs = [((t["token"], t["logprob"]) if isinstance(t, dict) else (t.token, t.logprob)) for t in tops]
+        except (AttributeError, IndexError, KeyError, TypeError) as e:
+            raise LMError(f"litellm {self.model} at {self.where}: the response has no token log-probabilities "
+                          f"({type(e).__name__}: {e}); this provider cannot do choice_probabilities") from None
+        variants = {c: set(choice_variants(c)) for c in choices}
+        mass = {c: 0.0 for c in choices}
+        for token, logprob in pairs:
+            for c, vs in variants.items():
+                if token in vs or any(v.startswith(token) and token.strip() for v in vs):
+                    mass[c] += math.exp(float(logprob))
+                    break
+        return renormalise(mass)

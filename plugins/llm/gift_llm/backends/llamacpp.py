@@ -1,0 +1,185 @@
+"""``llamacpp``: an in-process GGUF through llama-cpp-python.
+
+* Chat through ``create_chat_completion`` with the chat template stored in the GGUF.
+* ``json_schema`` constrains decoding with a :class:`llama_cpp.LlamaGrammar` (built from the schema; a
+  schema without ``properties`` gets the generic JSON-object grammar).
+* :meth:`LlamaCppLM.choice_probabilities` evaluates the chat prompt with the assistant turn opened and
+  reads the next-token distribution (variants such as ``yes``/``Yes``/`` yes`` are summed).
+* Prompt-prefix reuse: both paths keep the evaluated tokens in the KV cache, and the next call only
+  evaluates the suffix after the longest shared token prefix.
+
+One :class:`llama_cpp.Llama` is loaded per (model path, n_ctx) per process and shared by every backend
+instance on that file; calls to it are serialised by a lock.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from gift.core.data import Completion, Message, Usage
+from gift.core.errors import LMError
+from gift.core.interfaces import LMBackend
+from gift_llm.backends.common import first_token_ids, message_dicts, probabilities_from_logits
+
+_MODELS: dict[tuple[str, int], tuple[Any, threading.RLock]] = {}
+_MODELS_LOCK = threading.Lock()
+#: Number of GGUF loads in this process (tests check the default model is loaded once).
+LOAD_COUNT = 0
+
+
+def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int = 2, n_batch: int = 512,
+               seed: int = 0, verbose: bool = False) -> tuple[Any, threading.RLock]:
+    """The shared ``Llama`` for ``path`` (loaded on first use) and the lock guarding it."""
+    global LOAD_COUNT
+    path = Path(path).expanduser().resolve()
+    if not path.is_file():
+        raise LMError(f"llamacpp: model file {path} does not exist")
+    key = (str(path), int(n_ctx))
+    with _MODELS_LOCK:
+        if key in _MODELS:
+            return _MODELS[key]
+        try:
+            from llama_cpp import Llama
+        except ImportError as e:
+            raise LMError("llamacpp: llama-cpp-python is not installed (bash scripts/setup.sh installs it)") from e
+        try:
+            llama = Llama(model_path=str(path), n_ctx=int(n_ctx), n_threads=int(n_threads), n_batch=int(n_batch),
+                          seed=int(seed), logits_all=False, verbose=verbose)
+        except Exception as e:  # noqa: BLE001 - llama.cpp raises ValueError/RuntimeError on bad files
+            raise LMError(f"llamacpp: cannot load {path}: {type(e).__name__}: {e}") from e
+        LOAD_COUNT += 1
+        _MODELS[key] = (llama, threading.RLock())
+        return _MODELS[key]
+
+
+class LlamaCppLM(LMBackend):
+    """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities)."""
+
+    name: ClassVar[str] = "llamacpp"
+    supports_choice_probabilities: ClassVar[bool] = True
+
+    def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int = 2,
+                 n_batch: int = 512, seed: int = 0, verbose: bool = False, **_ignored: Any):
+        if model is None:
+            from gift_llm.embedded import embedded_model_path
+
+            model = embedded_model_path()
+        self.path = Path(model).expanduser().resolve()
+        self.model = self.path.name
+        self.n_ctx = int(n_ctx)
+        if self.n_ctx < 256:
+            raise LMError(f"llamacpp: n_ctx={n_ctx} is too small (use at least 256)")
+        self._opts = dict(n_ctx=self.n_ctx, n_threads=n_threads, n_batch=n_batch, seed=seed, verbose=verbose)
+        self._llama: Any = None
+        self._lock: threading.RLock | None = None
+        self._grammars: dict[str, Any] = {}
+        self._formatter: Any = None
+
+    # ------------------------------------------------------------------ model
+    @property
+    def llama(self) -> Any:
+        """The shared ``llama_cpp.Llama`` (loaded on first access)."""
+        if self._llama is None:
+            self._llama, self._lock = load_llama(self.path, **self._opts)
+        return self._llama
+
+    def identity(self) -> str:
+        return f"{self.name}:{self.model}"
+
+    def _grammar(self, schema: Mapping[str, Any]) -> Any:
+        from llama_cpp import LlamaGrammar
+        from llama_cpp.llama_grammar import JSON_GBNF
+
+        key = json.dumps(schema, sort_keys=True)
+        if key not in self._grammars:
+            try:
+                if schema.get("properties") or schema.get("items") or schema.get("enum"):
+                    self._grammars[key] = LlamaGrammar.from_json_schema(key, verbose=False)
+                else:
+                    self._grammars[key] = LlamaGrammar.from_string(JSON_GBNF, verbose=False)
+            except Exception as e:  # noqa: BLE001
+                raise LMError(f"llamacpp: cannot build a grammar from the JSON schema {key[:200]}: {e}") from e
+        return self._grammars[key]
+
+    # ------------------------------------------------------------------ complete
+    def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
+                 max_tokens: int = 512, stop: Sequence[str] | None = None,
+                 json_schema: Mapping[str, Any] | None = None) -> Completion:
+        llama = self.llama
+        kwargs: dict[str, Any] = dict(messages=message_dicts(messages), temperature=float(temperature),
+                                      max_tokens=int(max_tokens), stop=list(stop) if stop else None)
+        if seed is not None:
+            kwargs["seed"] = int(seed)
+        if json_schema is not None:
+            kwargs["grammar"] = self._grammar(json_schema)
+        assert self._lock is not None
+        t0 = time.perf_counter()
+        with self._lock:
+            try:
+                out = llama.create_chat_completion(**kwargs)
+            except ValueError as e:  # e.g. prompt longer than the context window
+                raise LMError(f"llamacpp {self.model}: {e} (n_ctx={self.n_ctx}; raise it with n_ctx=...)") from e
+        latency = time.perf_counter() - t0
+        usage = out.get("usage") or {}
+        text = out["choices"][0]["message"].get("content") or ""
+        return Completion(text, Usage(prompt_tokens=int(usage.get("prompt_tokens", 0)),
+                                      completion_tokens=int(usage.get("completion_tokens", 0)),
+                                      latency_s=latency, cost_usd=0.0), model=self.identity())
+
+    # ------------------------------------------------------------------ log-probabilities
+    def _prompt_tokens(self, messages: Sequence[Message]) -> list[int]:
+        """Chat-formatted prompt with the assistant turn opened, as tokens."""
+        llama = self.llama
+        if self._formatter is None:
+            from llama_cpp.llama_chat_format import Jinja2ChatFormatter
+
+            template = llama.metadata.get("tokenizer.chat_template")
+            if not template:
+                raise LMError(f"llamacpp {self.model}: the GGUF has no chat template; choice_probabilities "
+                              f"needs one")
+            eos, bos = llama.token_eos(), llama.token_bos()
+            text_of = llama._model.token_get_text  # noqa: SLF001 - same helper Llama uses for its templates
+            self._formatter = Jinja2ChatFormatter(template=template, eos_token=text_of(eos) if eos != -1 else "",
+                                                  bos_token=text_of(bos) if bos != -1 else "",
+                                                  add_generation_prompt=True)
+        res = self._formatter(messages=message_dicts(messages))
+        return llama.tokenize(res.prompt.encode("utf-8"), add_bos=not res.added_special, special=True)
+
+    def next_token_logits(self, tokens: Sequence[int]) -> np.ndarray:
+        """Logits ``[vocab]`` of the token after ``tokens``, evaluating only the suffix not yet in the KV cache."""
+        llama = self.llama
+        tokens = list(tokens)
+        if len(tokens) >= self.n_ctx:
+            raise LMError(f"llamacpp {self.model}: prompt of {len(tokens)} tokens does not fit n_ctx={self.n_ctx}")
+        prefix = 0
+        for a, b in zip(llama._input_ids.tolist(), tokens):  # noqa: SLF001
+            if a != b:
+                break
+            prefix += 1
+        prefix = min(prefix, len(tokens) - 1)  # always decode at least one token to get fresh logits
+        llama.n_tokens = prefix
+        llama.eval(tokens[prefix:])  # eval drops KV entries past n_tokens first
+        self.last_reused_tokens = prefix
+        logits = np.ctypeslib.as_array(llama._ctx.get_logits(), shape=(llama.n_vocab(),))  # noqa: SLF001
+        return np.array(logits, dtype=np.float64)
+
+    def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
+        if not choices:
+            raise LMError("choice_probabilities: no choices given")
+        llama = self.llama
+        assert self._lock is not None
+
+        def tok(s: str) -> list[int]:
+            return llama.tokenize(s.encode("utf-8"), add_bos=False, special=False)
+
+        with self._lock:
+            ids = first_token_ids(list(choices), tok)
+            logits = self.next_token_logits(self._prompt_tokens(messages))
+        return probabilities_from_logits(logits, ids)

@@ -1,0 +1,26 @@
+"""Where gift keeps its caches: ``$GIFT_CACHE_DIR`` or the user cache directory (``~/.cache/gift``)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+
+def cache_root() -> Path:
+    """Root of every gift cache; ``GIFT_CACHE_DIR`` overrides the platform's user cache directory."""
+    env = os.environ.get("GIFT_CACHE_DIR", "").strip()
+    if env:
+        return Path(env).expanduser()
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("gift", appauthor=False))
+
+
+def models_dir() -> Path:
+    """Directory of assembled model files (the embedded GGUF)."""
+    return cache_root() / "models"
+
+
+def lm_cache_path() -> Path:
+    """SQLite file of the persistent LM cache."""
+    return cache_root() / "lm" / "lm-cache.sqlite"
