@@ -128,8 +128,10 @@ def oracle_cut(scores: Sequence[float], labels: Sequence[bool]) -> float:
 class AlignmentScores:
     """Everything the kernel said about one test scene, before a threshold is chosen.
 
-    ``K`` ``[n_test, n_train]``; ``decision`` ``[n_test]`` (aligned iff ``>= threshold``; predicted
-    relevant when ``relevant_train`` is known); ``target`` ``[n_test]`` training column of the match;
+    ``K`` ``[n_test, n_train]``; ``decision`` ``[n_test]`` (predicted relevant iff ``>= threshold``);
+    ``aligned`` ``[n_test]`` (mapped to ``target`` iff ``>= threshold``, else DISTRACTOR: ``K`` at the
+    target for matrix kernels, the relevance for relevance kernels); ``target`` ``[n_test]`` training
+    column of the match;
     ``train_mean``: mean of K over distinct training pairs (None if not computed); ``loo_scores`` /
     ``loo_labels`` ``[m]``: leave-one-out decision scores of the training objects and whether each is
     relevant (None if not computed).
@@ -141,6 +143,7 @@ class AlignmentScores:
     K: np.ndarray = attrs.field(eq=False)
     decision: np.ndarray = attrs.field(eq=False)
     target: np.ndarray = attrs.field(eq=False)
+    aligned: np.ndarray = attrs.field(eq=False)
     kernel: str = ""
     train_mean: float | None = None
     loo_scores: np.ndarray | None = attrs.field(default=None, eq=False)
@@ -187,11 +190,11 @@ class AlignmentScores:
         raise GiftError(f"unknown threshold {strategy!r}; use one of {THRESHOLDS} or a number in [0, 1]")
 
     def alignment(self, cut: float) -> Alignment:
-        """The Alignment for a cut: aligned iff ``decision >= cut``; scores = K at the matched object."""
+        """The Alignment for a cut: aligned iff ``aligned >= cut``; scores = K at the matched object."""
         mapping, scores = {}, {}
         for i, name in enumerate(self.test):
             k = float(self.K[i, self.target[i]]) if self.train else 0.0
-            mapping[name] = self.train[self.target[i]] if self.train and self.decision[i] >= cut else DISTRACTOR
+            mapping[name] = self.train[self.target[i]] if self.train and self.aligned[i] >= cut else DISTRACTOR
             scores[name] = k
         return Alignment(mapping=mapping, scores=scores, threshold=float(cut), kernel=self.kernel)
 
@@ -219,8 +222,10 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         decision = _check_vector(kernel.relevance(test, train, intent, tuple(relevant_train)), len(test), kernel,
                                  "the test objects")
         target = np.argmax(np.where(rel_mask[None, :], K, -np.inf), axis=1)
+        aligned = decision
     else:
         decision, target = matrix_decision(K, rel_mask)
+        aligned = K[np.arange(len(test)), target] if len(train) else np.zeros(len(test))
     train_mean = loo_scores = loo_labels = None
     need = set(need)
     Ktt = None
@@ -240,7 +245,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
             loo_scores, _ = matrix_decision(Ktt, rel_mask, valid=~np.eye(len(train), dtype=bool))
     return AlignmentScores(test=tuple(o.name for o in test), train=tuple(names),
                            relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
-                           kernel=kname, train_mean=train_mean, loo_scores=loo_scores, loo_labels=loo_labels)
+                           aligned=aligned, kernel=kname, train_mean=train_mean, loo_scores=loo_scores, loo_labels=loo_labels)
 
 
 def _loo_relevance(kernel: Any, train: tuple[ObjectSpec, ...], intent: Intent | None,

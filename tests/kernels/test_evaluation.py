@@ -1,0 +1,94 @@
+"""evaluate-alignment and align: real MiniLM on a suite file, the CLI, failure isolation."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gift
+from gift.cli import main
+from gift.core.suite import load_suite
+from gift_kernels.evaluation import REPORT_SUBSETS, evaluate_alignment, parse_kernel_spec
+
+pytestmark = pytest.mark.slow
+
+SUITE = str(Path(__file__).parent / "data" / "mini_suite.yaml")
+
+
+def test_evaluation_reports_every_subset_threshold_and_intent_and_keeps_going_after_a_failure():
+    res = evaluate_alignment(SUITE, ["language", "language:use_descriptions=true", "no-such-kernel"])
+    assert res["suite"] == "kernels-mini" and res["thresholds"] == ["oracle", "non-oracle", "train-calibrated"]
+    assert "no such" not in json.dumps(res["kernels"]["language"]["errors"])
+    assert res["kernels"]["no-such-kernel"]["errors"]["*"].startswith("UnknownComponentError")
+    suite = load_suite(SUITE)
+    for name in ("language", "language:use_descriptions=true"):
+        k = res["kernels"][name]
+        assert not k["errors"] and set(k["intents"]) == {"art_supplies", "valuables"}
+        for thr in res["thresholds"]:
+            union = k["overall"][thr]["all"]
+            assert union["n"] == sum(len(s.test) for s in suite.intents)
+            assert union["tp"] + union["fn"] == sum(len(s.relevant_test) for s in suite.intents)
+            assert set(k["overall"][thr]) == set(REPORT_SUBSETS)  # the mini suite has every subset
+        # the oracle cut is an upper bound of F1 on each intent
+        for r in k["intents"].values():
+            f1 = {t: r["metrics"][t]["all"]["f1"] for t in res["thresholds"]}
+            assert f1["oracle"] >= max(f1["non-oracle"], f1["train-calibrated"]) - 1e-12
+            assert 0.0 <= r["metrics"]["oracle"]["all"]["auc"] <= 1.0
+    # the language confound of the paper: toothbrush matches paintbrush by name
+    obj = res["kernels"]["language"]["intents"]["art_supplies"]["objects"]
+    assert obj["toothbrush"]["match"] == "paintbrush"
+    json.dumps(res)  # everything is JSON-able
+
+
+def test_train_calibrated_uses_no_test_label(tmp_path):
+    text = Path(SUITE).read_text().replace("{object: toothbrush, relevant: false", "{object: toothbrush, relevant: true")
+    flipped = tmp_path / "flipped.yaml"
+    flipped.write_text(text)
+    a = evaluate_alignment(SUITE, ["language"], thresholds=["train-calibrated", "oracle"])
+    b = evaluate_alignment(str(flipped), ["language"], thresholds=["train-calibrated", "oracle"])
+    ca = a["kernels"]["language"]["intents"]["art_supplies"]["thresholds"]
+    cb = b["kernels"]["language"]["intents"]["art_supplies"]["thresholds"]
+    assert ca["train-calibrated"] == cb["train-calibrated"]
+    ma = a["kernels"]["language"]["intents"]["art_supplies"]["metrics"]["train-calibrated"]["all"]
+    mb = b["kernels"]["language"]["intents"]["art_supplies"]["metrics"]["train-calibrated"]["all"]
+    assert (ma["tp"], ma["fp"]) != (mb["tp"], mb["fp"])  # the labels did change, the cut did not
+
+
+def test_cli_evaluate_alignment_json_and_table(tmp_path, capsys):
+    out = tmp_path / "res.json"
+    code = main(["evaluate-alignment", "--suite", SUITE, "--kernels", "language", "--threshold", "non-oracle",
+                 "--intents", "valuables", "--out", str(out), "--quiet"])
+    assert code == 0
+    table = capsys.readouterr().out
+    assert "| language | non-oracle | union |" in table and "valuables" in table
+    saved = json.loads(out.read_text())
+    assert list(saved["kernels"]["language"]["intents"]) == ["valuables"]
+    assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", "language", "--threshold", "median",
+                 "--quiet"]) == 1
+    assert "unknown threshold" in capsys.readouterr().err
+    assert main(["evaluate-alignment", "--suite", str(tmp_path / "nope.yaml"), "--kernels", "language"]) == 1
+    assert "nope.yaml" in capsys.readouterr().err
+
+
+def test_cli_align_with_objects_outside_any_catalog(capsys):
+    code = main(["align", "--train", "paintbrush", "sketchbook", "banana", "--test", "toothbrush", "glue stick",
+                 "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json"])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    rows = {r["object"]: r for r in out["alignment"]}
+    assert rows["toothbrush"]["target"] == "paintbrush" and rows["toothbrush"]["relevant"] is True
+    assert out["threshold"] == 0.5 and np.array(out["similarity"]["K"]).shape == (2, 3)
+    assert 0.0 <= out["error_bound_per_state"] <= 1.0
+    assert main(["align", "--train", "a", "--test", "a", "--kernel", "language"]) == 1
+    assert "both training and test" in capsys.readouterr().err
+    assert main(["align", "--train", "a", "--test", "b", "--kernel", "language", "--threshold", "oracle"]) == 1
+
+
+def test_kernel_specs():
+    assert parse_kernel_spec("language:use_descriptions=true") == ("language", {"use_descriptions": True})
+    assert parse_kernel_spec("gift:samples=3:temperature=0.7") == ("gift", {"samples": 3, "temperature": 0.7})
+    with pytest.raises(gift.GiftError, match="key=value"):
+        parse_kernel_spec("gift:samples")
