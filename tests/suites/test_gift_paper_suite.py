@@ -283,3 +283,8 @@ def test_doc_tables_match_the_suite(suite):
         assert rows == want, i.id
         rel = ", ".join(i.relevant_train)
         assert f"**relevant** {rel};" in section, i.id
+        sizes = [len(i.subset(c)) or "–" for c in ("R", "lang", "vis", "unk")]
+        summary = (f"| `{i.id}` | {{}} | `{i.task}` | {len(i.train_objects)} ({len(i.relevant_train)}) | "
+                   f"{len(i.test)} ({len(i.relevant_test)}) | " + " | ".join(map(str, sizes)) + " |")
+        assert re.search(re.escape(summary).replace(r"\{\}", r"\S+"), text), f"summary row of {i.id}"
+    assert f"a catalog of {len(suite.objects)} objects" in text
