@@ -23,14 +23,14 @@ SUITE = "gift-paper"
 
 #: The paper's six ground-truth intents: suite id -> (task family, intent text).
 PAPER_INTENTS = {
-    "mug_water_sensitive": ("place_mug", "avoid carrying fluids near water-sensitive objects"),
-    "spill_paper": ("sweep_spill", "sweep paper-based items away from the spill"),
-    "pack_art_supplies": ("pack_backpack", "pack art supplies"),
-    "pack_reading_material": ("pack_backpack", "pack reading material"),
-    "store_valuables": ("store_drawer", "store valuables"),
-    "store_electronics": ("store_drawer", "store electronics"),
+    "water_sensitive": ("place_mug", "avoid carrying fluids near water-sensitive objects"),
+    "paper_based": ("sweep_spill", "sweep paper-based items away from the spill"),
+    "art_supplies": ("pack_backpack", "pack art supplies"),
+    "reading_material": ("pack_backpack", "pack reading material"),
+    "valuables": ("store_drawer", "store valuables"),
+    "electronics": ("store_drawer", "store electronics"),
 }
-SIBLINGS = [("pack_art_supplies", "pack_reading_material"), ("store_valuables", "store_electronics")]
+SIBLINGS = [("art_supplies", "reading_material"), ("valuables", "electronics")]
 CONFOUNDED = [i for pair in SIBLINGS for i in pair]
 
 #: Every object the paper names.
@@ -183,7 +183,7 @@ def test_confound_subsets_meet_their_minimum(suite, intent_id):
     assert all(n >= 4 for n in sizes.values()), sizes
 
 
-@pytest.mark.parametrize("intent_id", ["mug_water_sensitive", "spill_paper"])
+@pytest.mark.parametrize("intent_id", ["water_sensitive", "paper_based"])
 def test_place_and_sweep_are_s_r_only(suite, intent_id):
     i = suite.intent(intent_id)
     assert i.subset("R") == i.test
@@ -233,7 +233,7 @@ def test_language_confounds_are_named_like_an_object_of_the_opposite_label(suite
 
 def test_paper_examples_keep_their_roles(suite):
     """The confounds the paper discusses are in the subsets it puts them in, with its labels."""
-    art, val = suite.intent("pack_art_supplies"), suite.intent("store_valuables")
+    art, val = suite.intent("art_supplies"), suite.intent("valuables")
     item = {t.object: t for t in art.test} | {t.object: t for t in val.test}
     assert "paintbrush" in art.relevant_train and "diamond ring" in val.relevant_train
     assert "lang" in item["toothbrush"].confounds and not item["toothbrush"].relevant
