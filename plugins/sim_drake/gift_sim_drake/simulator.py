@@ -1,0 +1,75 @@
+"""The Drake simulators ``drake-franka`` and ``drake-jaco``: :class:`gift.core.interfaces.Simulator` on a real
+Drake ``MultibodyPlant`` (scenes, trajectories, features, renders)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import ClassVar
+
+import numpy as np
+
+from gift.core.data import FeatureBatch, ObjectSpec, Scene, TrajectoryBatch
+from gift.core.errors import GiftError
+from gift.core.interfaces import Simulator, Task
+from gift_sim_drake.features import compute_features, resolve_task
+from gift_sim_drake.motion import GENERATORS, N_STEPS, MotionPlanner
+from gift_sim_drake.robots import get_robot
+from gift_sim_drake.scenes import FAMILIES, check_family, layout
+
+
+def as_object_specs(objects: Sequence[ObjectSpec | str]) -> tuple[ObjectSpec, ...]:
+    """Objects given as :class:`ObjectSpec` or bare names (which get the default appearance)."""
+    out = []
+    for i, o in enumerate(objects):
+        if isinstance(o, str):
+            o = ObjectSpec(o)
+        if not isinstance(o, ObjectSpec):
+            raise GiftError(f"object {i} must be an ObjectSpec or a name, got {type(o).__name__}")
+        out.append(o)
+    return tuple(out)
+
+
+class DrakeSimulator(Simulator):
+    """Tabletop scenes of the four task families for one arm, on Drake."""
+
+    robot_name: ClassVar[str] = "franka"
+    n_steps = N_STEPS
+    dof = 7
+    generators = GENERATORS
+    families = tuple(sorted(FAMILIES))
+
+    def __init__(self, render_cache_dir: str | None = None) -> None:
+        self.robot = get_robot(self.robot_name)
+        self.planner = MotionPlanner(self.robot)
+        self.render_cache_dir = render_cache_dir
+
+    def make_scene(self, task: str, objects: Sequence[ObjectSpec | str], relevant: Sequence[str] = (),
+                   seed: int = 0) -> Scene:
+        family = resolve_task(task)  # unknown names: UnknownComponentError listing the registered families
+        check_family(family.name)
+        return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed))
+
+    def generate(self, scene: Scene, generator: str = "preferred", n: int = 1, seed: int = 0) -> TrajectoryBatch:
+        return self.planner.generate(scene, generator, n, seed)
+
+    def features(self, trajectories: TrajectoryBatch, task: str | Task) -> FeatureBatch:
+        return compute_features(trajectories, task)
+
+    def render_object(self, obj: ObjectSpec, size: int = 224) -> np.ndarray:
+        from gift_sim_drake.render import render_object
+
+        return render_object(obj, size=size, cache_dir=self.render_cache_dir)
+
+
+class DrakeFranka(DrakeSimulator):
+    """Franka Panda (7-DoF) on a Drake MultibodyPlant: the four task families, features, renders."""
+
+    name = "drake-franka"
+    robot_name = "franka"
+
+
+class DrakeJaco(DrakeSimulator):
+    """Kinova Jaco2 7-DoF (j2s7s300) on a Drake MultibodyPlant: the four task families, features, renders."""
+
+    name = "drake-jaco"
+    robot_name = "jaco"
