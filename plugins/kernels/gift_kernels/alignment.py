@@ -206,7 +206,9 @@ class AlignmentScores:
 def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                     intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
                     need: Sequence[str] = THRESHOLDS) -> AlignmentScores:
-    """Run the kernel once for a test scene (plus the training-set calls ``need`` asks for)."""
+    """Run the kernel once for a test scene: ``similarity(test + train, train)`` when ``need`` has a
+    training-set threshold (rows of the training objects give K(train, train)), else ``similarity(test, train)``.
+    Relevance kernels are also asked ``relevance()`` (and ``loo_relevance()`` for train-calibrated)."""
     test, train = tuple(test), tuple(train)
     names = [o.name for o in train]
     unknown = [r for r in relevant_train if r not in names]
@@ -216,7 +218,14 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         raise GiftError(f"duplicate test object names: {[o.name for o in test]}")
     kname = getattr(kernel, "name", type(kernel).__name__)
     rel_mask = np.array([n in set(relevant_train) for n in names], dtype=bool)
-    K = _check_matrix(kernel.similarity(test, train, intent), len(test), len(train), kernel, "the test objects")
+    need = set(need)
+    want_train = ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1
+    # one kernel call for test and training rows together: an LM kernel then spends no extra calls on
+    # the training-set thresholds (its call count stays per scene, not per threshold)
+    rows = test + train if want_train else test
+    K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
+                          "the test objects" + (" and the training objects" if want_train else ""))
+    K, Ktt = K_all[:len(test)], (K_all[len(test):] if want_train else None)
     use_relevance = bool(relevant_train) and callable(getattr(kernel, "relevance", None))
     if use_relevance:
         decision = _check_vector(kernel.relevance(test, train, intent, tuple(relevant_train)), len(test), kernel,
@@ -227,14 +236,10 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         decision, target = matrix_decision(K, rel_mask)
         aligned = K[np.arange(len(test)), target] if len(train) else np.zeros(len(test))
     train_mean = loo_scores = loo_labels = None
-    need = set(need)
-    Ktt = None
-    if ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1:
-        Ktt = _check_matrix(kernel.similarity(train, train, intent), len(train), len(train), kernel,
-                            "the training objects against each other")
+    if Ktt is not None:
         off = ~np.eye(len(train), dtype=bool)
         train_mean = float(Ktt[off].mean())
-    if "train-calibrated" in need and relevant_train and len(train) > 1:
+    if "train-calibrated" in need and relevant_train and Ktt is not None:
         loo_labels = rel_mask.copy()
         if use_relevance:
             loo_scores = _loo_relevance(kernel, train, intent, tuple(relevant_train))

@@ -121,6 +121,7 @@ def configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
     p.add_argument("--lm", default=None, help="LM backend for LM kernels and intent inference")
     p.add_argument("--json", action="store_true", help="print the full result as JSON")
     p.add_argument("--out", default=None, metavar="FILE", help="also write the full JSON result to FILE")
+    p.add_argument("--detailed", action="store_true", help="also print every metric per subset")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
 
@@ -137,6 +138,6 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
                                 lm=args.lm, intents=intents, progress=progress)
     if args.out:
         Path(args.out).write_text(json.dumps(result, indent=2), encoding="utf-8")
-    print(json.dumps(result, indent=2) if args.json else format_report(result))
+    print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
     failed = [k for k, d in result["kernels"].items() if d["errors"]]
     return 1 if len(failed) == len(kernels) else 0

@@ -271,26 +271,43 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
 # ----------------------------------------------------------------------------- text report
 
 
-def format_report(result: Mapping[str, Any], *, per_intent: bool = True) -> str:
-    """Markdown tables: overall per kernel x threshold x subset, then per intent (all subsets' union)."""
+def format_report(result: Mapping[str, Any], *, per_intent: bool = True, detailed: bool = False) -> str:
+    """Markdown tables: per kernel x threshold on the union (P, R, F1, AUC, FP, FN) with F1 and FP/FN per
+    subset; then F1 per intent; ``detailed`` adds every metric per subset."""
     thresholds = result["thresholds"]
-    lines = [f"Suite `{result['suite']}`, intent source `{result['intent_source']}`", ""]
-    lines += ["| kernel | threshold | subset | n | precision | recall | F1 | AUC (mean/intent) | FP | FN |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+    subs = [s for s in REPORT_SUBSETS if s != "all"]
+    lines = [f"Suite `{result['suite']}`, intent source `{result['intent_source']}`. Union = every test object, "
+             f"pooled over intents; AUC = mean over intents.", ""]
+    lines += ["| kernel | threshold | P | R | F1 | AUC | FP | FN | " + " | ".join(f"F1 {_subset_label(s)}" for s in subs)
+              + " | " + " | ".join(f"FP/FN {_subset_label(s)}" for s in subs) + " |",
+              "|---" * (8 + 2 * len(subs)) + "|"]
     for kname, k in result["kernels"].items():
         if not k["overall"]:
-            lines.append(f"| {kname} | - | - | - | error | | | | | |")
+            lines.append(f"| {kname} | - | error: {_first_error(k)} |" + " |" * (6 + 2 * len(subs)))
             continue
         for thr in thresholds:
-            for sub in REPORT_SUBSETS:
-                m = k["overall"].get(thr, {}).get(sub)
-                if m is None:
-                    continue
-                lines.append(f"| {kname} | {thr} | {_subset_label(sub)} | {m['n']} | {m['precision']:.2f} | "
-                             f"{m['recall']:.2f} | {m['f1']:.2f} | {_f(m['auc_mean_intent'])} | {m['fp']} | "
-                             f"{m['fn']} |")
+            o = k["overall"].get(thr, {})
+            u = o.get("all")
+            if u is None:
+                continue
+            f1s = " | ".join(f"{o[s]['f1']:.2f}" if s in o else "-" for s in subs)
+            fpfn = " | ".join(f"{o[s]['fp']}/{o[s]['fn']}" if s in o else "-" for s in subs)
+            lines.append(f"| {kname} | {thr} | {u['precision']:.2f} | {u['recall']:.2f} | **{u['f1']:.2f}** | "
+                         f"{_f(u['auc_mean_intent'])} | {u['fp']} | {u['fn']} | {f1s} | {fpfn} |")
+    if detailed:
+        lines += ["", "| kernel | threshold | subset | n | precision | recall | F1 | AUC (mean/intent) | FP | FN |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for kname, k in result["kernels"].items():
+            for thr in thresholds:
+                for sub in REPORT_SUBSETS:
+                    m = k["overall"].get(thr, {}).get(sub)
+                    if m is None:
+                        continue
+                    lines.append(f"| {kname} | {thr} | {_subset_label(sub)} | {m['n']} | {m['precision']:.2f} | "
+                                 f"{m['recall']:.2f} | {m['f1']:.2f} | {_f(m['auc_mean_intent'])} | {m['fp']} | "
+                                 f"{m['fn']} |")
     if per_intent:
-        lines += ["", "Per intent (all test objects; F1 per threshold, AUC):", "",
+        lines += ["", "Per intent (all its test objects):", "",
                   "| kernel | intent | " + " | ".join(f"F1 {t}" for t in thresholds) + " | AUC |",
                   "|---|---|" + "---|" * (len(thresholds) + 1)]
         for kname, k in result["kernels"].items():
@@ -303,6 +320,10 @@ def format_report(result: Mapping[str, Any], *, per_intent: bool = True) -> str:
         lines += ["", "Errors:"]
         lines += [f"- {k} / {i}: {e.splitlines()[0]}" for k, i, e in errs]
     return "\n".join(lines)
+
+
+def _first_error(k: Mapping[str, Any]) -> str:
+    return next(iter(k["errors"].values()), "no result").splitlines()[0].replace("|", "/")
 
 
 def _subset_label(sub: str) -> str:
