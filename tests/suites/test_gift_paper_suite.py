@@ -273,7 +273,7 @@ def test_doc_example_suite_loads(tmp_path):
 
 
 def test_doc_tables_match_the_suite(suite):
-    """Every test item's row in docs/suites.md shows the suite's label and subsets."""
+    """Every test item's row in docs/suites.md shows the suite's label and subsets (regenerate: scripts/suite_doc_tables.py)."""
     text = DOC.read_text(encoding="utf-8")
     for i in suite.intents:
         section = text.split(f"#### `{i.id}`", 1)[1].split("\n#### ", 1)[0].split("\n## ", 1)[0]
