@@ -9,6 +9,7 @@ simulator (default ``drake-franka``'s :meth:`render_object`), each view goes thr
 
 from __future__ import annotations
 
+import hashlib
 import threading
 from collections.abc import Callable, Sequence
 from typing import ClassVar
@@ -93,7 +94,7 @@ class VisionKernel(SimilarityKernel):
     """K = (1 + cos(v(test), v(train))) / 2, v = EfficientNet-Lite0 features averaged over three renders.
 
     ``simulator``: registered simulator whose ``render_object`` draws the views; or pass ``renderer``
-    (a callable ObjectSpec -> ``[views, H, W, 3]`` uint8) with a ``renderer_id`` naming it for the cache.
+    (a callable ObjectSpec -> ``[views, H, W, 3]`` uint8) with a ``renderer_id`` naming it in reports.
     """
 
     name: ClassVar[str] = "vision"
@@ -105,31 +106,42 @@ class VisionKernel(SimilarityKernel):
             renderer = simulator_renderer(simulator, image_size)
             renderer_id = renderer_id or renderer.identity  # type: ignore[attr-defined]
         elif not renderer_id:
-            raise GiftError("vision kernel: a custom renderer needs a renderer_id (it keys the embedding cache)")
+            raise GiftError("vision kernel: a custom renderer needs a renderer_id (it names the renderer in reports)")
         self.renderer = renderer
         self.renderer_id = renderer_id
-        self._cache = EmbeddingCache(f"{MODEL_ID}-{_safe(renderer_id)}")
+        self._cache = EmbeddingCache(f"{MODEL_ID}-views")
+        self._renders: dict[str, np.ndarray] = {}
 
     def __repr__(self) -> str:
         return f"VisionKernel(renderer={self.renderer_id!r})"
 
+    def render(self, obj: ObjectSpec) -> np.ndarray:
+        """The views ``[views, H, W, 3]`` uint8 of one object (memoised per name and appearance)."""
+        key = _key(obj)
+        views = self._renders.get(key)
+        if views is None:
+            views = np.asarray(self.renderer(obj))
+            if views.ndim == 3:
+                views = views[None]
+            if views.ndim != 4 or views.shape[-1] != 3 or views.dtype != np.uint8:
+                raise GiftError(f"vision kernel: renderer {self.renderer_id!r} returned {views.dtype} images of shape "
+                                f"{views.shape} for {obj.name!r}; expected [views, H, W, 3] uint8 RGB")
+            self._renders[key] = views
+        return views
+
     def embed_objects(self, objects: Sequence[ObjectSpec]) -> np.ndarray:
-        """View-averaged features ``[n, 1280]`` (cached per object name and appearance)."""
-        by_key = {_key(o): o for o in objects}
+        """View-averaged features ``[n, 1280]``, cached by the content of the rendered images.
 
-        def compute(keys: list[str]) -> np.ndarray:
-            out = []
-            for k in keys:
-                views = np.asarray(self.renderer(by_key[k]))
-                if views.ndim == 3:
-                    views = views[None]
-                if views.dtype != np.uint8:
-                    raise GiftError(f"vision kernel: renderer {self.renderer_id!r} returned {views.dtype} images "
-                                    f"for {by_key[k].name!r}; expected uint8 RGB")
-                out.append(image_features(views).mean(axis=0))
-            return np.stack(out)
-
-        return self._cache.embed([_key(o) for o in objects], compute)
+        Keying on the pixels (not the name) means a changed renderer never serves stale features, and
+        objects that look the same share one entry.
+        """
+        keys, views = [], {}
+        for o in objects:
+            v = self.render(o)
+            keys.append(hashlib.sha1(v.tobytes() + str(v.shape).encode()).hexdigest())
+            views[keys[-1]] = v
+        return self._cache.embed(keys, lambda missing: np.stack([image_features(views[k]).mean(axis=0)
+                                                                 for k in missing]))
 
     def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                    intent: Intent | None = None) -> np.ndarray:
@@ -143,7 +155,3 @@ class VisionKernel(SimilarityKernel):
 def _key(obj: ObjectSpec) -> str:
     a = obj.appearance
     return f"{obj.name}|{a.shape}|{a.size}|{a.color}"
-
-
-def _safe(text: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_.@" else "_" for c in text)
