@@ -115,7 +115,8 @@ def add_spill(plant: MultibodyPlant, center: Sequence[float]) -> None:
 
 def add_free_object(plant: MultibodyPlant, name: str, appearance: Appearance, mass: float = 0.2):
     """A free rigid body with the appearance's geometry. Returns the body."""
-    body = plant.AddRigidBody(name, SpatialInertia(mass, np.zeros(3), UnitInertia.SolidSphere(0.04)))
+    instance = plant.AddModelInstance(name)
+    body = plant.AddRigidBody(name, instance, SpatialInertia(mass, np.zeros(3), UnitInertia.SolidSphere(0.04)))
     _add_visual_collision(plant, body, name, shape_of(appearance), RigidTransform(), appearance.color)
     return body
 

@@ -78,8 +78,8 @@ def layout(task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str], se
     elif mark == "spill":
         s = np.array([0.42 + rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)])
         landmarks["spill"] = (float(s[0]), float(s[1]), 0.0)
-        slots = np.array([(dx, sy * dy) for sy in (1.0, -1.0) for dx, dy in ((-0.12, 0.13), (0.0, 0.12),
-                                                                              (0.12, 0.13))])
+        slots = np.array([(dx, sy * dy) for sy in (1.0, -1.0) for dx, dy in ((-0.12, 0.1), (0.0, 0.09),
+                                                                              (0.12, 0.1))])
         if n > len(slots):
             raise GiftError(f"a sweep_spill scene holds at most {len(slots)} objects, got {n}")
         pick = rng.permutation(len(slots))[:n]
