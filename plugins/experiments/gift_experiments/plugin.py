@@ -54,8 +54,8 @@ def run_reproduce(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     results = run(cfg, out, Progress(enabled=not args.quiet), log=lambda m: print(m, file=sys.stderr))
     results["timing"]["total"] = time.perf_counter() - t0
-    path = write_report(results, out, command="gift " + " ".join(shlex.quote(a) for a in sys.argv[2:])
-                        if sys.argv[1:2] == ["reproduce"] else "")
+    argv = sys.argv[sys.argv.index("reproduce"):] if "reproduce" in sys.argv else ["reproduce"]
+    path = write_report(results, out, command="gift " + " ".join(shlex.quote(a) for a in argv))
     print(f"report: {path}")
     return 0
 

@@ -162,10 +162,14 @@ def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str):
     sim = comp.simulator(robot)
     task = gift.get_task(spec.task)
     specs = task.feature_specs(spec.train_objects)
-    objects = suite.specs(spec.train_objects)
+    rel = list(spec.relevant_train)
+    irr = [o for o in spec.train_objects if o not in rel]
     demos, alts, pairs = [], [], []
     for k in range(comp.cfg.train_scenes):
-        scene = sim.make_scene(spec.task, objects, spec.relevant_train, seed=_seed("train", spec.id, k))
+        # each training scene holds a random subset of the training objects (several configurations)
+        seed = _seed("train", spec.id, k)
+        names = _pick(rel, irr, comp.cfg.test_objects_per_scene, np.random.default_rng(seed))
+        scene = sim.make_scene(spec.task, suite.specs(names), [n for n in names if n in rel], seed=seed)
         pref = _features(sim, sim.generate(scene, "preferred", comp.cfg.demos_per_scene, _seed("p", spec.id, k)),
                          spec.task, specs)
         default = _features(sim, sim.generate(scene, "default", comp.cfg.demos_per_scene, _seed("d", spec.id, k)),
@@ -178,19 +182,27 @@ def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str):
     return FeatureBatch.concat(demos), FeatureBatch.concat(alts), pairs, specs
 
 
+def _pick(rel: Sequence[str], irr: Sequence[str], n: int, rng: np.random.Generator) -> list[str]:
+    """``n`` names (fewer if there are not enough), at least one relevant and one irrelevant when both exist."""
+    n = min(n, len(rel) + len(irr))
+    lo = 1 if rel and irr else (n if rel else 0)
+    hi = min(len(rel), n - (1 if irr else 0))
+    k_rel = int(rng.integers(lo, max(lo, hi) + 1)) if rel else 0
+    k_rel = min(k_rel, len(rel))
+    names = list(rng.choice(rel, k_rel, replace=False)) if k_rel else []
+    names += list(rng.choice(irr, min(n - k_rel, len(irr)), replace=False)) if irr and n > k_rel else []
+    rng.shuffle(names)
+    return [str(x) for x in names]
+
+
 def test_scene(comp: Components, suite: Suite, spec: IntentSpec, robot: str, seed: int,
                n_objects: int | None = None) -> Scene:
     """A randomised test scene of unseen objects with at least one relevant and one irrelevant object."""
-    rng = np.random.default_rng(seed)
-    n = n_objects or comp.cfg.test_objects_per_scene
     rel = [t.object for t in spec.test if t.relevant]
     irr = [t.object for t in spec.test if not t.relevant]
     if not rel or not irr:
         raise GiftError(f"intent {spec.id!r} needs relevant and irrelevant test objects")
-    k_rel = int(rng.integers(1, min(len(rel), n - 1) + 1))
-    names = list(rng.choice(rel, k_rel, replace=False)) + list(rng.choice(irr, min(n - k_rel, len(irr)),
-                                                                             replace=False))
-    rng.shuffle(names)
+    names = _pick(rel, irr, n_objects or comp.cfg.test_objects_per_scene, np.random.default_rng(seed))
     relevant = [x for x in names if x in rel]
     return comp.simulator(robot).make_scene(spec.task, suite.specs(names), relevant, seed=seed)
 
