@@ -32,19 +32,26 @@ def check_family(task: str) -> str:
     return FAMILIES[task]
 
 
-def _place(rng: np.random.Generator, radii: np.ndarray, sample, what: str, tries: int = 400) -> np.ndarray:
-    """Rejection-sample non-overlapping xy positions ``[n, 2]``; ``sample(rng)`` proposes one point."""
-    out: list[np.ndarray] = []
-    for i, r in enumerate(radii):
-        for _ in range(tries):
-            p = sample(rng)
-            if all(np.hypot(*(p - q)) >= r + radii[j] + 0.03 for j, q in enumerate(out)):
-                out.append(p)
+def _place(rng: np.random.Generator, radii: np.ndarray, sample, what: str, restarts: int = 30,
+           tries: int = 60) -> np.ndarray:
+    """Rejection-sample non-overlapping xy positions ``[n, 2]`` (largest objects first, restarting the whole
+    layout when one does not fit); ``sample(rng)`` proposes one point."""
+    order = np.argsort(-radii, kind="stable")
+    for _ in range(restarts):
+        out: dict[int, np.ndarray] = {}
+        for i in order:
+            for _ in range(tries):
+                p = sample(rng)
+                if all(np.hypot(*(p - q)) >= radii[i] + radii[j] + 0.015 for j, q in out.items()):
+                    out[int(i)] = p
+                    break
+            else:
                 break
-        else:
-            raise GiftError(f"cannot place {len(radii)} objects of these sizes in the {what} region without "
-                            f"overlap (object {i} did not fit); use fewer or smaller objects")
-    return np.array(out).reshape(len(radii), 2)
+        if len(out) == len(radii):
+            return np.array([out[i] for i in range(len(radii))]).reshape(len(radii), 2)
+    raise GiftError(f"cannot place {len(radii)} objects of these sizes (footprint radii "
+                    f"{np.round(radii, 3).tolist()} m) in the {what} region without overlap; use fewer or smaller "
+                    f"objects")
 
 
 def nominal_target(task: str, positions: np.ndarray, landmarks: dict) -> int:
