@@ -183,6 +183,8 @@ def _number(tok: str) -> int | float:
 
 _ESCAPES = {"n": "\n", "t": "\t", "r": "\r", "b": "\b", "f": "\f", "0": "\0", "\\": "\\", "'": "'",
             '"': '"', "/": "/", "\n": ""}
+_HEX_WIDTH = {"x": 2, "u": 4, "U": 8}
+_HEX = re.compile(r"[0-9a-fA-F]+")
 
 
 def _unescape(body: str) -> str:
@@ -197,22 +199,21 @@ def _unescape(body: str) -> str:
             i += 1
             continue
         e = body[i + 1]
+        hexs = body[i + 2:i + 2 + _HEX_WIDTH.get(e, 0)]
         if e in _ESCAPES:
             out.append(_ESCAPES[e])
             i += 2
-        elif e in "ux" and re.fullmatch(r"[0-9a-fA-F]+", body[i + 2:i + (6 if e == "u" else 4)] or "-"):
-            width = 4 if e == "u" else 2
-            hexs = body[i + 2:i + 2 + width]
-            if len(hexs) == width:
-                out.append(chr(int(hexs, 16)))
-                i += 2 + width
-            else:
-                out.append(body[i:i + 2])
-                i += 2
+        elif e in _HEX_WIDTH and len(hexs) == _HEX_WIDTH[e] and _HEX.fullmatch(hexs) and int(hexs, 16) <= 0x10FFFF:
+            out.append(chr(int(hexs, 16)))
+            i += 2 + len(hexs)
         else:
             out.append(body[i:i + 2])
             i += 2
-    return "".join(out)
+    text = "".join(out)
+    try:  # join UTF-16 surrogate pairs written as two \\u escapes (JSON's way to spell non-BMP characters)
+        return text.encode("utf-16", "surrogatepass").decode("utf-16")
+    except UnicodeError:
+        return text
 
 
 def _strip_fence(text: str) -> str:

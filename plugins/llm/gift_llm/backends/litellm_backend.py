@@ -43,7 +43,8 @@ class LiteLLM(LMBackend):
 
     def __init__(self, model: str | None = None, *, api_base: str | None = None, api_key_env: str | None = None,
                  timeout_s: float = 120.0, max_retries: int = 4, backoff_s: float = 1.0, backoff_max_s: float = 30.0,
-                 logprobs: bool | None = None, top_logprobs: int = 20, **_ignored: Any):
+                 logprobs: bool | None = None, top_logprobs: int = 20, json_style: str | None = None,
+                 **_ignored: Any):
         if not model:
             raise LMError("litellm backend: name a model, e.g. --lm litellm:openai/gpt-4o")
         self.model = str(model)
@@ -57,6 +58,21 @@ class LiteLLM(LMBackend):
         self.supports_choice_probabilities = (provider in LOGPROB_PROVIDERS if logprobs is None  # type: ignore[misc]
                                               else bool(logprobs))
         self.top_logprobs = int(top_logprobs)
+        if json_style not in (None, "json_schema", "json_object_schema"):
+            raise LMError(f"litellm {self.model}: json_style must be 'json_schema' or 'json_object_schema', "
+                          f"got {json_style!r}")
+        self.json_style = json_style
+
+    def _response_format(self, schema: Mapping[str, Any]) -> dict[str, Any]:
+        """OpenAI style (``json_schema``) for providers; llama.cpp-server style (``json_object`` + ``schema``)
+        for OpenAI-compatible servers at ``api_base``."""
+        style = self.json_style or ("json_object_schema" if self.api_base and self.model.startswith("openai/")
+                                    else "json_schema")
+        if style == "json_object_schema":
+            return {"type": "json_object", "schema": dict(schema)}
+        if not schema.get("properties"):
+            return {"type": "json_object"}
+        return {"type": "json_schema", "json_schema": {"name": "answer", "schema": dict(schema)}}
 
     def identity(self) -> str:
         return f"{self.name}:{self.model}" + (f"@{self.api_base}" if self.api_base else "")
@@ -113,8 +129,7 @@ class LiteLLM(LMBackend):
         if stop:
             kw["stop"] = list(stop)
         if json_schema is not None:
-            kw["response_format"] = ({"type": "json_schema", "json_schema": {"name": "answer", "schema": json_schema}}
-                                     if json_schema.get("properties") else {"type": "json_object"})
+            kw["response_format"] = self._response_format(json_schema)
         t0 = time.perf_counter()
         resp = self._call(**kw)
         latency = time.perf_counter() - t0

@@ -66,7 +66,8 @@ class LlamaCppLM(LMBackend):
     supports_choice_probabilities: ClassVar[bool] = True
 
     def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int = 2,
-                 n_batch: int = 512, seed: int = 0, verbose: bool = False, **_ignored: Any):
+                 n_batch: int = 512, seed: int = 0, reuse_prefix: bool = True, verbose: bool = False,
+                 **_ignored: Any):
         if model is None:
             from gift_llm.embedded import embedded_model_path
 
@@ -76,6 +77,10 @@ class LlamaCppLM(LMBackend):
         self.n_ctx = int(n_ctx)
         if self.n_ctx < 256:
             raise LMError(f"llamacpp: n_ctx={n_ctx} is too small (use at least 256)")
+        #: Keep the KV cache of the previous call and evaluate only the new suffix (False: re-evaluate all).
+        self.reuse_prefix = bool(reuse_prefix)
+        #: Prompt tokens taken from the KV cache in the last :meth:`next_token_logits` call.
+        self.last_reused_tokens = 0
         self._opts = dict(n_ctx=self.n_ctx, n_threads=n_threads, n_batch=n_batch, seed=seed, verbose=verbose)
         self._llama: Any = None
         self._lock: threading.RLock | None = None
@@ -122,6 +127,8 @@ class LlamaCppLM(LMBackend):
         assert self._lock is not None
         t0 = time.perf_counter()
         with self._lock:
+            if not self.reuse_prefix:
+                llama.reset()
             try:
                 out = llama.create_chat_completion(**kwargs)
             except ValueError as e:  # e.g. prompt longer than the context window
@@ -159,11 +166,12 @@ class LlamaCppLM(LMBackend):
         if len(tokens) >= self.n_ctx:
             raise LMError(f"llamacpp {self.model}: prompt of {len(tokens)} tokens does not fit n_ctx={self.n_ctx}")
         prefix = 0
-        for a, b in zip(llama._input_ids.tolist(), tokens):  # noqa: SLF001
-            if a != b:
-                break
-            prefix += 1
-        prefix = min(prefix, len(tokens) - 1)  # always decode at least one token to get fresh logits
+        if self.reuse_prefix:
+            for a, b in zip(llama._input_ids.tolist(), tokens):  # noqa: SLF001
+                if a != b:
+                    break
+                prefix += 1
+        prefix = max(0, min(prefix, len(tokens) - 1))  # always decode at least one token to get fresh logits
         llama.n_tokens = prefix
         llama.eval(tokens[prefix:])  # eval drops KV entries past n_tokens first
         self.last_reused_tokens = prefix
