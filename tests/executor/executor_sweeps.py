@@ -116,3 +116,25 @@ def max_overlap(intervals: list[tuple[float, float]]) -> int:
         live += step
         best = max(best, live)
     return best
+
+
+# ------------------------------------------------------------------ LM calls through the shared cache
+@functools.lru_cache(maxsize=4)
+def _cached_lm(cache_path: str, limit: Any, n_ctx: int):
+    """Per worker process: the embedded llama.cpp model behind the LM plugin's SQLite cache at
+    ``cache_path``; model calls (cache misses only) hold ``limit``."""
+    from gift.core.executor import RateLimitedLM
+    from gift_llm.cache import CachedLM
+
+    inner = gift.get_lm("llamacpp", n_ctx=n_ctx, n_threads=1)
+    if limit is not None:
+        inner = RateLimitedLM(inner, limit)
+    return CachedLM(inner, path=cache_path)
+
+
+def ask_lm(cache_path: str, limit: Any, item: tuple[str, int]) -> tuple[str, bool]:
+    """``item = (question, seed)`` -> ``(answer text, answered from the cache?)`` (temperature 0, 6 tokens)."""
+    question, seed = item
+    lm = _cached_lm(cache_path, limit, 512)
+    out = lm.complete([gift.Message("user", question)], temperature=0.0, seed=int(seed), max_tokens=6)
+    return out.text, bool(out.usage.cached)

@@ -235,3 +235,31 @@ def test_rate_limited_lm_keeps_the_backend_identity_and_holds_a_slot(tmp_path):
     other.release(token)
     worker.join(timeout=5)
     assert inner.calls == 2 and not worker.is_alive()
+
+
+# ------------------------------------------------------------------ real LM behind the shared SQLite cache
+@pytest.mark.slow
+@pytest.mark.lm
+def test_lm_cache_written_by_one_process_serves_local_and_ray_workers(tmp_path, local_executor, ray_executor):
+    """The LM plugin's SQLite cache at a shared path: answers computed by the embedded llama.cpp model in
+    this process are read, not recomputed, by local pool workers and by Ray workers."""
+    pytest.importorskip("llama_cpp")
+    from gift.core.errors import LMError
+    from gift_llm.embedded import embedded_model_path
+
+    try:
+        embedded_model_path()
+    except LMError as e:
+        pytest.skip(f"embedded model not installed: {e}")
+    cache = str(tmp_path / "shared-lm-cache.sqlite")
+    questions = [("Name one fruit.", 0), ("Name one color.", 0), ("Name one fruit.", 1)]
+    limit = RateLimit(1, key="llamacpp:embedded", directory=str(tmp_path))
+    fn = functools.partial(sweeps.ask_lm, cache, limit)
+
+    first = SerialExecutor().map(fn, questions)                    # the only model calls of this test
+    assert [hit for _, hit in first] == [False, False, False]
+    assert all(text.strip() for text, _ in first)
+    items = questions * 3
+    want = [(text, True) for text, _ in first] * 3
+    assert local_executor.map(fn, items, chunksize=1) == want     # every answer a cache hit, same text
+    assert ray_executor.map(fn, items, chunksize=1) == want
