@@ -12,6 +12,22 @@ def gift_register_kernels(register):
              "(use_descriptions=True: names + descriptions)")
     register("vision", VisionKernel, description="cosine of EfficientNet-Lite0 features of three renders per object")
 
+    from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel
+
+    register("gift", MappingKernel, description="GIFT Call 3: LM maps test objects under the intent; K = vote "
+             "share of N samples (default 10)")
+    register("lm-no-intent", NoIntentMappingKernel, description="Call 3 without the intent (the paper's ablation)")
+    register("gift-prob", GiftProbKernel, description="continuous GIFT kernel: LM log-odds that an object is what "
+             "the goal is about, z-averaged with MiniLM description similarity")
+
+
+@hookimpl
+def gift_register_intent_estimators(register):
+    from gift_kernels.intent import LMContrastiveIntentEstimator
+
+    register("lm-contrastive", LMContrastiveIntentEstimator,
+             description="GIFT Calls 1-2: motivations from preferred-vs-default traces, then semantic axes")
+
 
 @hookimpl
 def gift_register_alignment_operators(register):
@@ -31,3 +47,8 @@ def gift_register_commands(register):
     register("evaluate-alignment", cli.run_evaluate_alignment,
              help="precision/recall/F1/AUC/FP/FN of kernels on a suite, per intent and per subset",
              configure=cli.configure_evaluate_alignment)
+
+    from gift_kernels import intent_cli
+
+    register("infer-intent", intent_cli.run_infer_intent, help="infer the intent (Calls 1-2) from saved "
+             "demonstration pairs", configure=intent_cli.configure_infer_intent)

@@ -1,0 +1,189 @@
+"""``lm-contrastive``: the intent estimator J_LM(D_H, D_¬H) of GIFT (Calls 1 and 2).
+
+Call 1 shows the LM demonstration pairs as textual feature traces (default vs preferred), the features'
+descriptions and the features of other scenes, and asks for three ranked motivations, each with the
+features it concerns (only features that exist), plus semantic similarities. Call 2 turns the
+motivations into semantic axes: short yes/no questions with the objects (that exist) answering yes.
+Both answers go through ``gift_llm.structured.ask_dict`` with a validator, so an unknown feature or
+object triggers a repair request naming it.
+
+To fit a 1.5B model with a 4k context, each trace shows only the features whose preferred and default
+values differ (at most ``max_features`` per pair, largest difference first), at about ``max_steps``
+evenly spaced time steps; every other feature is listed by name.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+import numpy as np
+
+from gift.core.data import DemonstrationPair, Intent, Motivation, SemanticAxis
+from gift.core.errors import GiftError, ValidationError
+from gift.core.interfaces import IntentEstimator, LMBackend
+from gift_kernels import prompts
+from gift_kernels.lm_kernels import resolve_lm
+
+
+def _norm(s: Any) -> str:
+    return " ".join(str(s).replace("_", " ").lower().split())
+
+
+def _entries(value: Any, key: str) -> list[tuple[str, list]]:
+    """``[{"text"|"question": ..., "features"|"objects": [...]}, ...]`` or ``{text: [...]}`` -> pairs."""
+    if isinstance(value, Mapping):
+        return [(str(k), v if isinstance(v, list) else [v]) for k, v in value.items()]
+    if not isinstance(value, list):
+        raise ValidationError(f"expected a list of entries, got {type(value).__name__}")
+    out = []
+    for e in value:
+        if not isinstance(e, Mapping):
+            raise ValidationError(f"each entry must be an object with a text and a list, got {e!r}")
+        text = e.get("text", e.get("question", e.get("motivation", e.get("axis"))))
+        items = e.get(key, [])
+        if not isinstance(text, str) or not text.strip():
+            raise ValidationError(f"an entry has no text: {dict(e)!r}")
+        out.append((text.strip(), items if isinstance(items, list) else [items]))
+    return out
+
+
+def parse_motivations(answer: Mapping[str, Any], features: Sequence[str]) -> tuple[list[Motivation],
+                                                                                    list[SemanticAxis]]:
+    """Validate Call 1: up to 3 motivations whose features all exist (+ semantic similarities).
+
+    Raises :class:`ValidationError` (a ValueError) naming unknown features or a missing ``motivations`` entry.
+    """
+    known = {_norm(f): f for f in features}
+    if "motivations" not in answer:
+        raise ValidationError(f"the answer has no 'motivations' key (keys: {list(answer)})")
+    mots, unknown = [], []
+    for text, feats in _entries(answer["motivations"], "features"):
+        names = []
+        for f in feats:
+            name = known.get(_norm(f))
+            if name is None:
+                unknown.append(str(f))
+            elif name not in names:
+                names.append(name)
+        mots.append(Motivation(text=text, features=tuple(names)))
+    if unknown:
+        raise ValidationError(f"features {sorted(set(unknown))} do not exist; use only: {list(features)}")
+    if not mots:
+        raise ValidationError("no motivation was given; give three")
+    sims = []
+    raw = answer.get("semantic_similarities", [])
+    try:
+        for q, feats in _entries(raw, "features"):
+            sims.append(SemanticAxis(question=q, objects=tuple(known[_norm(f)] for f in feats if _norm(f) in known)))
+    except ValidationError:
+        sims = []  # optional part: a malformed one is dropped, the motivations are kept
+    return mots[:3], sims
+
+
+def parse_axes(answer: Mapping[str, Any], objects: Sequence[str]) -> list[SemanticAxis]:
+    """Validate Call 2: axes (yes/no questions) over object names that exist; unknown names raise."""
+    known = {_norm(o): o for o in objects}
+    if "axes" not in answer:
+        raise ValidationError(f"the answer has no 'axes' key (keys: {list(answer)})")
+    axes, unknown = [], []
+    for q, objs in _entries(answer["axes"], "objects"):
+        names = []
+        for o in objs:
+            name = known.get(_norm(o))
+            if name is None:
+                unknown.append(str(o))
+            elif name not in names:
+                names.append(name)
+        axes.append(SemanticAxis(question=q, objects=tuple(names)))
+    if unknown:
+        raise ValidationError(f"objects {sorted(set(unknown))} do not exist; use only: {list(objects)}")
+    return axes
+
+
+class LMContrastiveIntentEstimator(IntentEstimator):
+    """Calls 1 and 2 of GIFT: motivations from preferred-vs-default feature traces, then semantic axes."""
+
+    name: ClassVar[str] = "lm-contrastive"
+
+    def __init__(self, lm: LMBackend | str | None = None, max_steps: int = 8, max_features: int = 6,
+                 temperature: float = 0.0, seed: int = 0, max_repairs: int = 2, axes: bool = True) -> None:
+        if max_steps < 2 or max_features < 1:
+            raise GiftError(f"lm-contrastive: max_steps must be >= 2 and max_features >= 1, got {max_steps}, "
+                            f"{max_features}")
+        self._lm_spec, self._lm = lm, None
+        self.max_steps, self.max_features = int(max_steps), int(max_features)
+        self.temperature, self.seed, self.max_repairs, self.with_axes = float(temperature), int(seed), \
+            int(max_repairs), bool(axes)
+        self.calls = 0
+
+    @property
+    def lm(self) -> LMBackend:
+        if self._lm is None:
+            self._lm = resolve_lm(self._lm_spec)
+        return self._lm
+
+    # ------------------------------------------------------------------ prompt material
+    def shown_features(self, pair: DemonstrationPair) -> list[str]:
+        """Features of ``pair`` whose preferred and default traces differ most (at most ``max_features``)."""
+        diff = np.abs(pair.preferred.values - pair.default.values).max(axis=0)
+        order = [i for i in np.argsort(-diff, kind="stable") if diff[i] > 1e-3][: self.max_features]
+        return [pair.preferred.specs[i].name for i in sorted(order)]
+
+    def pair_texts(self, demonstrations: Sequence[DemonstrationPair]) -> tuple[list[tuple[str, str]], dict, list]:
+        """(default, preferred) texts per pair, descriptions of the shown features, the other features."""
+        texts, desc, every_name = [], {}, {}
+        for pair in demonstrations:
+            shown = self.shown_features(pair)
+            every = max(1, math.ceil(pair.preferred.values.shape[0] / self.max_steps))
+            texts.append((pair.default.to_text(shown, every=every), pair.preferred.to_text(shown, every=every)))
+            for s in pair.preferred.specs:
+                every_name.setdefault(s.name, s.description)
+                if s.name in shown:
+                    desc[s.name] = s.description
+        others = [n for n in every_name if n not in desc]
+        return texts, desc, others
+
+    # ------------------------------------------------------------------ calls
+    def motivations(self, demonstrations: Sequence[DemonstrationPair], task_context: str = ""
+                    ) -> tuple[list[Motivation], list[SemanticAxis]]:
+        """Call 1: ranked motivations (features validated) and semantic similarities."""
+        from gift_llm.structured import ask_dict
+
+        if not demonstrations:
+            raise GiftError("lm-contrastive: no demonstration pairs given")
+        texts, desc, others = self.pair_texts(demonstrations)
+        features = list(dict.fromkeys([*desc, *others]))
+        messages = prompts.intent_messages(texts, desc, others, task_context)
+        self.calls += 1
+        answer = ask_dict(self.lm, messages, validate=lambda d: parse_motivations(d, features) and None,
+                          max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
+                          required_keys=("motivations",))
+        return parse_motivations(answer, features)
+
+    def semantic_axes(self, motivations: Sequence[Motivation], objects: Sequence[str]) -> list[SemanticAxis]:
+        """Call 2: yes/no questions grouping ``objects`` under the motivations (names validated)."""
+        from gift_llm.structured import ask_dict
+
+        if not objects:
+            return []
+        messages = prompts.axes_messages([(m.text, m.features) for m in motivations], objects)
+        self.calls += 1
+        answer = ask_dict(self.lm, messages, validate=lambda d: parse_axes(d, objects) and None,
+                          max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
+                          required_keys=("axes",))
+        return parse_axes(answer, objects)
+
+    def estimate(self, demonstrations: Sequence[DemonstrationPair], *, task_context: str = "",
+                 objects: Sequence[str] = ()) -> Intent:
+        """The inferred intent: text = the top motivation; motivations ranked; axes over ``objects``.
+
+        ``objects`` defaults to the subjects of the demonstrations' semantic features.
+        """
+        mots, sims = self.motivations(demonstrations, task_context)
+        if not objects:
+            objects = list(dict.fromkeys(s.subject for p in demonstrations for s in p.preferred.specs
+                                         if s.subject is not None))
+        axes = self.semantic_axes(mots, list(objects)) if self.with_axes else []
+        return Intent(text=mots[0].text, motivations=tuple(mots), axes=tuple(axes or sims), source="inferred")

@@ -1,0 +1,392 @@
+"""LM kernels: ``gift`` (Call 3 with the intent), ``lm-no-intent`` (Call 3 without), and ``gift-prob``.
+
+``gift`` / ``lm-no-intent`` (:class:`MappingKernel`): one LM call per sample lists every test object
+(so the calls per intent are ``samples``, independent of the number of trajectories), each sample lists
+the objects in its own shuffled order with its own seed; ``K[i, j]`` = fraction of samples mapping test
+object i to training object j. The mode over {training objects, distractor} is the binary decision and
+its share the agreement rate (:meth:`MappingKernel.votes`).
+
+``gift-prob`` (:class:`GiftProbKernel`): a continuous kernel from one yes/no question per object, "is
+this object something the goal is about?", built from the goal's own words and the object's
+description and read through ``choice_probabilities``. Its score is the log-odds
+``log P(yes) - log P(no)``; by default it is averaged, as z-scores, with MiniLM description similarity
+to the training objects that are relevant under the intent (see ``docs/results/gift_prob.md`` for the
+variants measured). Training objects are never shown to the LM as labelled examples, so they can
+calibrate the threshold by leave-one-out.
+
+Matrix rule of the relevance kernels (``gift-prob``): ``K[i, j] = r_i`` for the training objects j that
+are relevant under the intent (``relevant_train`` when given, else the training objects whose own
+log-odds is positive, at least the best one), 0 for the others; ``r_i`` in [0, 1] is the relevance of
+test object i. :meth:`GiftProbKernel.relevance` returns ``r`` ``[n_test]`` directly.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+import attrs
+import numpy as np
+
+from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
+from gift.core.errors import GiftError, ValidationError
+from gift.core.interfaces import LMBackend, SimilarityKernel
+from gift_kernels import prompts
+
+#: Log-odds are clipped to ±LOGIT_CLIP (probabilities of exactly 0 or 1 would be infinite).
+LOGIT_CLIP = 12.0
+
+
+def resolve_lm(lm: LMBackend | str | None) -> LMBackend:
+    """An LM backend instance: ``lm`` itself, or ``gift_llm.resolve_lm(name_or_None)`` (the embedded default)."""
+    if isinstance(lm, LMBackend) or (lm is not None and not isinstance(lm, str) and hasattr(lm, "complete")):
+        return lm
+    try:
+        import gift_llm
+    except ImportError as e:  # pragma: no cover - gift-llm is a dependency of gift-kernels
+        raise GiftError("the LM kernels need the gift-llm plugin (pip install -e plugins/llm)") from e
+    return gift_llm.resolve_lm(lm)
+
+
+def _object_names(objs: Sequence[ObjectSpec | str]) -> list[str]:
+    return [o.name if isinstance(o, ObjectSpec) else str(o) for o in objs]
+
+
+# ============================================================================= Call 3 mapping kernels
+
+
+def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]) -> dict[str, str]:
+    """Validate a Call-3 answer: every test object mapped, targets only training objects or distractor.
+
+    Names are matched case- and whitespace-insensitively. Raises :class:`ValidationError` (a ValueError) naming what is
+    missing or unknown (``ask_dict`` turns that into a repair request).
+    """
+    def norm(s: Any) -> str:
+        return " ".join(str(s).replace("_", " ").lower().split())
+
+    tests = {norm(t): t for t in test}
+    targets = {norm(t): t for t in train}
+    targets[norm(DISTRACTOR)] = DISTRACTOR
+    out: dict[str, str] = {}
+    unknown_targets = []
+    for k, v in answer.items():
+        t = tests.get(norm(k))
+        if t is None:
+            continue  # an object that is not in the scene: ignored
+        if isinstance(v, (list, tuple)) and len(v) == 1:
+            v = v[0]
+        target = targets.get(norm(v)) if isinstance(v, str) else None
+        if target is None:
+            unknown_targets.append(f"{k!r} -> {v!r}")
+            continue
+        out[t] = target
+    problems = []
+    missing = [t for t in test if t not in out]
+    if unknown_targets:
+        problems.append(f"unknown targets {unknown_targets}; allowed: {list(train)} or {DISTRACTOR!r}")
+    if missing:
+        problems.append(f"these new objects are not mapped: {missing}")
+    if problems:
+        raise ValidationError("; ".join(problems))
+    return out
+
+
+@attrs.frozen
+class MappingVotes:
+    """Votes of N samples: ``counts`` ``[n_test, n_train + 1]`` (last column: distractor)."""
+
+    test: tuple[str, ...]
+    train: tuple[str, ...]
+    counts: np.ndarray = attrs.field(eq=False)
+    samples: int
+
+    @property
+    def shares(self) -> np.ndarray:
+        return self.counts / max(self.samples, 1)
+
+    def mode(self) -> dict[str, str]:
+        """Binary decision per test object: the most voted target (ties: training objects first)."""
+        targets = (*self.train, DISTRACTOR)
+        return {t: targets[int(np.argmax(self.counts[i]))] for i, t in enumerate(self.test)}
+
+    def agreement(self) -> dict[str, float]:
+        """Share of samples that agree with the mode, per test object (the confidence)."""
+        return {t: float(self.shares[i].max()) for i, t in enumerate(self.test)}
+
+
+class MappingKernel(SimilarityKernel):
+    """Call 3: the LM maps all test objects at once, ``samples`` times; K = vote shares."""
+
+    name: ClassVar[str] = "gift"
+    uses_intent: ClassVar[bool] = True
+
+    def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
+                 seed: int = 0, use_intent: bool = True, max_repairs: int = 2) -> None:
+        if not isinstance(samples, int) or samples < 1:
+            raise GiftError(f"{self.name} kernel: samples must be a positive integer, got {samples!r}")
+        self._lm_spec, self._lm = lm, None
+        self.samples, self.temperature, self.seed = samples, float(temperature), int(seed)
+        self.use_intent, self.max_repairs = bool(use_intent), int(max_repairs)
+        self.calls = 0  # LM calls made (including those served from the LM cache)
+
+    @property
+    def lm(self) -> LMBackend:
+        if self._lm is None:
+            self._lm = resolve_lm(self._lm_spec)
+        return self._lm
+
+    def _sample(self, test: list[str], train: list[str], intent: Intent | None, k: int) -> dict[str, str]:
+        from gift_llm.structured import ask_dict
+
+        rng = np.random.default_rng(self.seed * 1000 + k)
+        t_order = [test[i] for i in rng.permutation(len(test))]
+        s_order = [train[i] for i in rng.permutation(len(train))]
+        messages = prompts.mapping_messages(t_order, s_order, intent)
+        self.calls += 1
+        answer = ask_dict(self.lm, messages, validate=lambda d: parse_mapping(d, test, train),
+                          max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k)
+        return parse_mapping(answer, test, train)
+
+    def votes(self, test: Sequence[ObjectSpec | str], train: Sequence[ObjectSpec | str],
+              intent: Intent | None = None) -> MappingVotes:
+        """Run the ``samples`` Call-3 samples and count where each test object went."""
+        if self.use_intent and intent is None:
+            raise GiftError(f"the {self.name!r} kernel conditions on an intent; pass one (or use 'lm-no-intent')")
+        tests, trains = _object_names(test), _object_names(train)
+        counts = np.zeros((len(tests), len(trains) + 1))
+        col = {n: j for j, n in enumerate(trains)} | {DISTRACTOR: len(trains)}
+        row = {n: i for i, n in enumerate(tests)}
+        if tests and trains:
+            for k in range(self.samples):
+                for t, target in self._sample(tests, trains, intent if self.use_intent else None, k).items():
+                    counts[row[t], col[target]] += 1
+        return MappingVotes(tuple(tests), tuple(trains), counts, self.samples if tests and trains else 0)
+
+    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                   intent: Intent | None = None) -> np.ndarray:
+        """``[n_test, n_train]``: share of samples mapping test object i to training object j."""
+        v = self.votes(test, train, intent)
+        return v.shares[:, : len(v.train)] if v.samples else np.zeros((len(test), len(train)))
+
+
+class NoIntentMappingKernel(MappingKernel):
+    """Call 3 without the intent (the paper's LM-no-intent ablation); K = vote shares."""
+
+    name: ClassVar[str] = "lm-no-intent"
+    uses_intent: ClassVar[bool] = False
+
+    def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
+                 seed: int = 0, max_repairs: int = 2) -> None:
+        super().__init__(lm=lm, samples=samples, temperature=temperature, seed=seed, use_intent=False,
+                         max_repairs=max_repairs)
+
+
+# ============================================================================= gift-prob
+
+
+def _zscore(x: np.ndarray, ref: slice = slice(None)) -> np.ndarray:
+    """``(x - mean) / sd`` with the statistics of ``x[ref]``."""
+    mu, sd = x[ref].mean(), x[ref].std()
+    return (x - mu) / sd if sd > 1e-9 else x - mu
+
+
+def _sigmoid(x: np.ndarray) -> np.ndarray:
+    return 1.0 / (1.0 + np.exp(-np.asarray(x, dtype=float)))
+
+
+COMBINE = ("none", "language")
+EMBED_REFERENCE = ("relevant", "contrastive")
+STANDARDIZE = ("pooled", "train")
+
+
+class GiftProbKernel(SimilarityKernel):
+    """Continuous GIFT kernel: P(yes) that an object is what the goal is about, as log-odds.
+
+    Options: ``template`` (a key of :data:`gift_kernels.prompts.RELEVANCE_TEMPLATES`), ``use_descriptions``,
+    ``axes`` (also ask the intent's semantic-axis questions and keep the highest log-odds per object),
+    ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
+    similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
+    to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
+    object), ``weight`` of the language term in the average.
+    """
+
+    name: ClassVar[str] = "gift-prob"
+    uses_intent: ClassVar[bool] = True
+
+    def __init__(self, lm: LMBackend | str | None = None, template: str = "goal", use_descriptions: bool = True,
+                 axes: bool = False, combine: str = "language", embed_reference: str = "relevant",
+                 weight: float = 0.5, standardize: str = "pooled",
+                 language_kernel: SimilarityKernel | None = None) -> None:
+        if template not in prompts.RELEVANCE_TEMPLATES:
+            raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
+        if combine not in COMBINE:
+            raise GiftError(f"gift-prob: combine must be one of {COMBINE}, got {combine!r}")
+        if embed_reference not in EMBED_REFERENCE:
+            raise GiftError(f"gift-prob: embed_reference must be one of {EMBED_REFERENCE}, got {embed_reference!r}")
+        if standardize not in STANDARDIZE:
+            raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
+        if not 0.0 <= float(weight) <= 1.0:
+            raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
+        self._lm_spec, self._lm = lm, None
+        self.template, self.use_descriptions, self.axes = template, bool(use_descriptions), bool(axes)
+        self.combine, self.embed_reference, self.weight = combine, embed_reference, float(weight)
+        self.standardize = standardize
+        self._language = language_kernel
+        self._last: tuple[tuple, np.ndarray] | None = None  # (train key, LOO train scores) of the last call
+        self._memo: dict[tuple, float] = {}
+        self._lock = threading.Lock()
+        self.calls = 0  # distinct yes/no questions sent to the LM
+
+    def __repr__(self) -> str:
+        return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
+                f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
+                f"weight={self.weight})")
+
+    # ------------------------------------------------------------------ pieces
+    @property
+    def lm(self) -> LMBackend:
+        if self._lm is None:
+            lm = resolve_lm(self._lm_spec)
+            if not getattr(lm, "supports_choice_probabilities", False):
+                raise GiftError(
+                    f"gift-prob needs token log-probabilities, which the LM backend {lm.identity()!r} does not "
+                    f"provide; use the embedded llama.cpp model (the default) or another backend with "
+                    f"supports_choice_probabilities=True, or the binary 'gift' kernel on this backend")
+            self._lm = lm
+        return self._lm
+
+    @property
+    def language(self) -> SimilarityKernel:
+        if self._language is None:
+            import gift
+            from gift.core.errors import UnknownComponentError
+
+            try:
+                self._language = gift.get_kernel("language", use_descriptions=True)
+            except UnknownComponentError:  # the plugin's registration not loaded (e.g. GIFT_PLUGINS filter)
+                from gift_kernels.language import LanguageKernel
+
+                self._language = LanguageKernel(use_descriptions=True)
+        return self._language
+
+    def _ask(self, messages: tuple[Message, ...]) -> float:
+        key = (self.lm.identity(), tuple((m.role, m.content) for m in messages))
+        with self._lock:
+            if key in self._memo:
+                return self._memo[key]
+        probs = self.lm.choice_probabilities(messages, ["yes", "no"])
+        self.calls += 1
+        p_yes, p_no = float(probs.get("yes", 0.0)), float(probs.get("no", 0.0))
+        lo = math.log(max(p_yes, 1e-12)) - math.log(max(p_no, 1e-12))
+        lo = float(np.clip(lo, -LOGIT_CLIP, LOGIT_CLIP))
+        with self._lock:
+            self._memo[key] = lo
+        return lo
+
+    def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent) -> np.ndarray:
+        """``[n]`` log P(yes) − log P(no) that each object is what the goal is about (clipped to ±12)."""
+        if intent is None:
+            raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
+        out = np.empty(len(objects))
+        for i, o in enumerate(objects):
+            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions))
+            if self.axes:
+                for a in intent.axes:
+                    s = max(s, self._ask(prompts.axis_messages(o, a.question, self.use_descriptions)))
+            out[i] = s
+        return out
+
+    def _relevant_mask(self, train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str],
+                       train_lo: np.ndarray) -> np.ndarray:
+        names = [o.name for o in train]
+        if relevant_train:
+            unknown = set(relevant_train) - set(names)
+            if unknown:
+                raise GiftError(f"gift-prob: relevant_train names objects that are not training objects: "
+                                f"{sorted(unknown)}")
+            return np.array([n in set(relevant_train) for n in names])
+        mask = train_lo > 0.0
+        if not mask.any() and len(train):
+            mask[int(np.argmax(train_lo))] = True
+        return mask
+
+    def _embed_scores(self, objs: Sequence[ObjectSpec], train: Sequence[ObjectSpec], rel: np.ndarray,
+                      exclude_self: bool) -> np.ndarray:
+        """Description similarity of each object to the relevant training objects (``[n]``)."""
+        sim = np.asarray(self.language.similarity(list(objs), list(train)), dtype=float)
+        if exclude_self:
+            np.fill_diagonal(sim, np.nan)
+        with np.errstate(all="ignore"):
+            pos = np.nanmax(np.where(rel[None, :], sim, np.nan), axis=1) if rel.any() else np.zeros(len(objs))
+            out = pos
+            if self.embed_reference == "contrastive" and (~rel).any():
+                out = pos - np.nanmax(np.where(~rel[None, :], sim, np.nan), axis=1)
+        return np.nan_to_num(out, nan=0.0)
+
+    # ------------------------------------------------------------------ kernel API
+    def scores(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
+               relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+        """Unsquashed relevance scores of the test ``[n_test]`` and training objects ``[n_train]``.
+
+        Training objects are scored leave-one-out (a training object is never compared with itself),
+        on the same scale as the test objects, so they can calibrate a threshold.
+        """
+        test, train = list(test), list(train)
+        lo = self.log_odds(test + train, intent)
+        lo_test, lo_train = lo[: len(test)], lo[len(test):]
+        if self.combine == "none":
+            return lo_test, lo_train
+        rel = self._relevant_mask(train, intent, relevant_train, lo_train)
+        emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
+                              self._embed_scores(train, train, rel, True)])
+        ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
+        z = (1.0 - self.weight) * _zscore(lo, ref) + self.weight * _zscore(emb, ref)
+        out = z[: len(test)], z[len(test):]
+        self._last = (self._train_key(train, intent, relevant_train), out[1])
+        return out
+
+    @staticmethod
+    def _train_key(train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str]) -> tuple:
+        return (tuple(train), intent, tuple(sorted(relevant_train)))
+
+    def relevance(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
+                  relevant_train: Sequence[str] = ()) -> np.ndarray:
+        """``r`` ``[n_test]`` in [0, 1]: sigmoid of the relevance score (0.5 = undecided)."""
+        if not test:
+            return np.zeros(0)
+        return _sigmoid(self.scores(test, train, intent, relevant_train)[0])
+
+    def relevance_loo(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
+                      relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+        """``(r_test [n_test], r_train [n_train])`` in [0, 1] from one call, on one scale.
+
+        ``r_train`` is leave-one-out (no training object is compared with itself): the scores a
+        train-calibrated threshold should separate (relevant training objects vs the others).
+        """
+        s_test, s_train = self.scores(test, train, intent, relevant_train)
+        return _sigmoid(s_test), _sigmoid(s_train)
+
+    def loo_relevance(self, train: Sequence[ObjectSpec], intent: Intent | None = None,
+                      relevant_train: Sequence[str] = ()) -> np.ndarray:
+        """Leave-one-out ``r`` ``[n_train]`` of the training objects (the alignment operator's calibration).
+
+        On the scale of the last :meth:`relevance` call with the same training set, intent and
+        ``relevant_train`` (z-scores depend on the pool of objects scored together); else on its own.
+        """
+        key = self._train_key(train, intent, relevant_train)
+        if self._last is not None and self._last[0] == key:
+            return _sigmoid(self._last[1])
+        return _sigmoid(self.scores([], train, intent, relevant_train)[1])
+
+    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                   intent: Intent | None = None, relevant_train: Sequence[str] = ()) -> np.ndarray:
+        """``[n_test, n_train]``: ``r_i`` in the columns of the relevant training objects, 0 elsewhere."""
+        test, train = list(test), list(train)
+        if not test or not train:
+            return np.zeros((len(test), len(train)))
+        s_test, _ = self.scores(test, train, intent, relevant_train)
+        lo_train = self.log_odds(train, intent)
+        rel = self._relevant_mask(train, intent, relevant_train, lo_train)
+        return np.where(rel[None, :], _sigmoid(s_test)[:, None], 0.0)
