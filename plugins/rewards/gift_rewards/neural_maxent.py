@@ -6,12 +6,13 @@ One MLP reads a state's standardised features ``s_t`` ``[F]`` and gives two numb
 linear model's "mean over time + final step" features, so both models can express the same rewards.
 
 Training maximises the MaxEnt objective of :mod:`gift_rewards.maxent_base` (uniform proposal, L2 on the
-weight matrices) with full-batch Adam; ``torch.manual_seed(seed)`` fixes initialisation, and training
-stops early when the log-likelihood of held-out demonstrations (normalised over held-out alternatives)
-has not improved for ``patience`` epochs; the best epoch's weights are kept.
+weight matrices) with full-batch Adam in float32 on ``threads`` CPU threads (1 by default: this small net
+gains nothing from more, and loses much on a busy machine). ``torch.manual_seed(seed)`` fixes the
+initialisation, and training stops early when the log-likelihood of held-out demonstrations (normalised
+over held-out alternatives) has not improved for ``patience`` epochs; the best epoch's weights are kept.
 
-torch is imported lazily (only :meth:`NeuralMaxEntReward.fit` needs it); scoring runs in numpy (float64,
-the dtype of training too), so a loaded reward scores without torch.
+torch is imported lazily (only :meth:`NeuralMaxEntReward.fit` needs it); scoring runs in numpy (float64 on
+the learned float32 weights), so a loaded reward scores without torch and identically after a reload.
 """
 
 from __future__ import annotations
@@ -44,14 +45,15 @@ class NeuralMaxEntReward(MaxEntReward):
     ``hidden``: widths of the tanh hidden layers; ``l2``: weight of the squared weights' penalty;
     ``lr``: Adam step size; ``max_epochs``/``patience``: training length and early-stopping patience;
     ``val_fraction``: share of demonstrations and alternatives held out for early stopping (no split when
-    fewer than ``min_val_demos`` demonstrations would be held out); ``seed``: torch and split seed.
+    fewer than ``min_val_demos`` demonstrations would be held out); ``seed``: torch and split seed;
+    ``threads``: torch CPU threads during :meth:`fit`.
     """
 
     name: ClassVar[str] = "maxent-neural"
 
     def __init__(self, *, hidden: Sequence[int] = (32, 32), l2: float = 1e-3, lr: float = 1e-2,
                  max_epochs: int = 600, patience: int = 40, val_fraction: float = 0.2, min_val_demos: int = 2,
-                 seed: int = 0, metadata: Mapping[str, Any] | None = None) -> None:
+                 seed: int = 0, threads: int = 1, metadata: Mapping[str, Any] | None = None) -> None:
         super().__init__(metadata=metadata)
         hidden = tuple(int(h) for h in hidden)
         if not hidden or any(h < 1 for h in hidden):
@@ -60,12 +62,15 @@ class NeuralMaxEntReward(MaxEntReward):
             raise ValidationError(f"maxent-neural: l2 must be a finite number >= 0, got {l2!r}")
         if not (0.0 <= val_fraction < 1.0):
             raise ValidationError(f"maxent-neural: val_fraction must be in [0, 1), got {val_fraction!r}")
+        if int(threads) < 1:
+            raise ValidationError(f"maxent-neural: threads must be >= 1, got {threads!r}")
         if int(max_epochs) < 1 or int(patience) < 1 or not lr > 0:
             raise ValidationError(f"maxent-neural: need max_epochs >= 1, patience >= 1 and lr > 0, got "
                                   f"{max_epochs!r}, {patience!r}, {lr!r}")
         self.hidden, self.l2, self.lr = hidden, float(l2), float(lr)
         self.max_epochs, self.patience = int(max_epochs), int(patience)
         self.val_fraction, self.min_val_demos, self.seed = float(val_fraction), int(min_val_demos), int(seed)
+        self.threads = int(threads)
         self.layers: list[tuple[np.ndarray, np.ndarray]] = []  # (W [out, in], b [out]) per layer
         self.mean: np.ndarray | None = None  # [F] feature standardisation
         self.std: np.ndarray | None = None
@@ -73,12 +78,20 @@ class NeuralMaxEntReward(MaxEntReward):
     def hyperparameters(self) -> dict[str, Any]:
         return {"hidden": list(self.hidden), "l2": self.l2, "lr": self.lr, "max_epochs": self.max_epochs,
                 "patience": self.patience, "val_fraction": self.val_fraction,
-                "min_val_demos": self.min_val_demos, "seed": self.seed}
+                "min_val_demos": self.min_val_demos, "seed": self.seed, "threads": self.threads}
 
     # ------------------------------------------------------------------ training
 
     def _fit(self, demonstrations: np.ndarray, alternatives: np.ndarray) -> dict[str, Any]:
         torch = _import_torch()
+        threads = torch.get_num_threads()
+        torch.set_num_threads(self.threads)
+        try:
+            return self._train(torch, demonstrations, alternatives)
+        finally:
+            torch.set_num_threads(threads)
+
+    def _train(self, torch, demonstrations: np.ndarray, alternatives: np.ndarray) -> dict[str, Any]:
         torch.manual_seed(self.seed)
         rng = np.random.default_rng(self.seed)
         f = demonstrations.shape[2]
@@ -97,11 +110,11 @@ class NeuralMaxEntReward(MaxEntReward):
         for w_in, w_out in zip(widths[:-1], widths[1:]):
             mods += [torch.nn.Linear(w_in, w_out), torch.nn.Tanh()]
         mods.append(torch.nn.Linear(widths[-1], 2))
-        net = torch.nn.Sequential(*mods).double()
+        net = torch.nn.Sequential(*mods).float()
         linears = [m for m in net if isinstance(m, torch.nn.Linear)]
 
         def tensor(x: np.ndarray):
-            return torch.from_numpy(np.ascontiguousarray((x - self.mean) / self.std))
+            return torch.from_numpy(((x - self.mean) / self.std).astype(np.float32))
 
         def returns(x):  # [N, T, F] -> R [N]
             out = net(x)
@@ -133,7 +146,8 @@ class NeuralMaxEntReward(MaxEntReward):
             elif epoch - best_epoch >= self.patience:
                 break
         net.load_state_dict(best_state)
-        self.layers = [(m.weight.detach().numpy().copy(), m.bias.detach().numpy().copy()) for m in linears]
+        self.layers = [(m.weight.detach().numpy().astype(np.float64), m.bias.detach().numpy().astype(np.float64))
+                       for m in linears]
         return {"epochs": epoch, "best_epoch": best_epoch, "early_stopped": epoch < self.max_epochs,
                 "selection": "held-out log-likelihood" if vd is not None else "training objective",
                 "best_selection_value": best, "n_validation_demonstrations": 0 if d_val is None else len(d_val)}
