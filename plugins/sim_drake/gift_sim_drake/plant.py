@@ -201,20 +201,12 @@ class DrakeIK:
             hit = self._cache.get(key)
         if hit is not None:
             return hit.copy()
-        ik = InverseKinematics(self.plant)
-        tol = self.position_tolerance
-        ik.AddPositionConstraint(self.ee, np.zeros(3), self.plant.world_frame(), target - tol, target + tol)
-        ik.AddAngleBetweenVectorsConstraint(self.ee, np.array([0.0, 0.0, 1.0]), self.plant.world_frame(),
-                                            np.array([0.0, 0.0, -1.0]), 0.0, self.angle_tolerance)
-        prog = ik.get_mutable_prog()
-        q = ik.q()
-        # stay on the guess's branch: no wrapping of unlimited joints by 2 pi, no elbow flips
-        lo = np.maximum(self.plant.GetPositionLowerLimits(), guess - self.max_step)
-        hi = np.minimum(self.plant.GetPositionUpperLimits(), guess + self.max_step)
-        prog.AddBoundingBoxConstraint(lo, hi, q)
-        prog.AddQuadraticErrorCost(np.eye(len(guess)), guess, q)
-        prog.SetInitialGuess(q, guess)
-        result = Solve(prog)
+        # first near the guess (same branch: no 2 pi wraps, no elbow flips), then from the rest posture
+        result, q = None, None
+        for start in (guess, np.asarray(self.spec.rest, dtype=float)):
+            result, q = self._solve_once(target, start)
+            if result.is_success():
+                break
         if not result.is_success():
             raise GiftError(f"Drake IK found no {self.spec.name} configuration reaching {target.round(3).tolist()} "
                             f"with the gripper pointing down (solver {result.get_solver_id().name()}); the target is "
@@ -223,6 +215,21 @@ class DrakeIK:
         with self._lock:
             self._cache[key] = sol
         return sol.copy()
+
+    def _solve_once(self, target: np.ndarray, guess: np.ndarray):
+        ik = InverseKinematics(self.plant)
+        tol = self.position_tolerance
+        ik.AddPositionConstraint(self.ee, np.zeros(3), self.plant.world_frame(), target - tol, target + tol)
+        ik.AddAngleBetweenVectorsConstraint(self.ee, np.array([0.0, 0.0, 1.0]), self.plant.world_frame(),
+                                            np.array([0.0, 0.0, -1.0]), 0.0, self.angle_tolerance)
+        prog = ik.get_mutable_prog()
+        q = ik.q()
+        lo = np.maximum(self.plant.GetPositionLowerLimits(), guess - self.max_step)
+        hi = np.minimum(self.plant.GetPositionUpperLimits(), guess + self.max_step)
+        prog.AddBoundingBoxConstraint(lo, hi, q)
+        prog.AddQuadraticErrorCost(np.eye(len(guess)), guess, q)
+        prog.SetInitialGuess(q, guess)
+        return Solve(prog), q
 
 
 _IK: dict[str, DrakeIK] = {}
