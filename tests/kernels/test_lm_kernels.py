@@ -1,0 +1,222 @@
+"""LM kernels: ``gift``, ``lm-no-intent`` and ``gift-prob``.
+
+Parsing and control flow use a scripted fake LM defined here; the features themselves are shown on the
+embedded model (tests marked ``slow``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gift
+from gift.core.data import DISTRACTOR, Completion, Intent, ObjectSpec
+from gift.core.errors import GiftError, LMAnswerError, ValidationError
+from gift.core.interfaces import LMBackend
+from gift.core.suite import load_suite
+from gift_kernels import prompts
+from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_mapping
+
+SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
+
+TRAIN = [ObjectSpec("paintbrush", "a brush for paint"), ObjectSpec("sketchbook", "a book of drawing paper"),
+         ObjectSpec("banana", "a yellow fruit"), ObjectSpec("coffee mug", "a cup for hot drinks")]
+TEST = [ObjectSpec("crayons", "sticks of colored wax"), ObjectSpec("toothbrush", "a brush for teeth"),
+        ObjectSpec("apple", "a round red fruit")]
+ART = Intent(text="pack art supplies", source="ground-truth")
+
+
+class ScriptedLM(LMBackend):
+    """Fake LM for control-flow tests: ``answer(messages, seed)`` returns the text; records every call."""
+
+    name = "scripted"
+    model = "scripted"
+    supports_choice_probabilities = True
+
+    def __init__(self, answer=None, probs=None):
+        self.answer, self.probs, self.calls = answer, probs, []
+
+    def complete(self, messages, *, temperature=0.0, seed=None, max_tokens=512, stop=None, json_schema=None):
+        self.calls.append((list(messages), seed, temperature))
+        return Completion(self.answer(messages, seed))
+
+    def choice_probabilities(self, messages, choices):
+        self.calls.append((list(messages), None, 0.0))
+        return self.probs(messages[-1].content)
+
+
+class PlainLM(ScriptedLM):
+    supports_choice_probabilities = False
+
+
+def _names_in_order(text: str, key: str) -> list[str]:
+    line = next(ln for ln in text.splitlines() if ln.startswith(key))
+    return json.loads(line.split(":", 1)[1])
+
+
+# ----------------------------------------------------------------------------- Call 3 parsing and votes
+
+
+def test_parse_mapping_normalises_names_and_rejects_unknown_or_missing_objects():
+    test, train = ["coffee mug", "TV remote"], ["laptop", "glass vase"]
+    assert parse_mapping({"Coffee_Mug": "Glass Vase", "tv remote": "distractor", "ghost": "laptop"}, test, train) \
+        == {"coffee mug": "glass vase", "TV remote": DISTRACTOR}
+    with pytest.raises(ValidationError, match=r"unknown targets .*'spaceship'"):
+        parse_mapping({"coffee mug": "spaceship", "TV remote": "laptop"}, test, train)
+    with pytest.raises(ValidationError, match=r"not mapped: \['TV remote'\]"):
+        parse_mapping({"coffee mug": "laptop"}, test, train)
+    assert issubclass(ValidationError, ValueError)  # so gift_llm's ask_dict turns it into a repair request
+
+
+def test_gift_kernel_counts_votes_over_shuffled_seeded_samples_and_repairs_bad_answers():
+    bad_once = {"done": False}
+
+    def answer(messages, seed):
+        if not bad_once["done"]:  # the first answer forgets an object: a repair request must follow
+            bad_once["done"] = True
+            return '{"crayons": "paintbrush"}'
+        target = "paintbrush" if seed % 2 == 0 else "sketchbook"
+        return json.dumps({"crayons": target, "toothbrush": "distractor", "apple": "banana"})
+
+    lm = ScriptedLM(answer)
+    k = gift.get_kernel("gift", lm=lm, samples=4)
+    votes = k.votes(TEST, TRAIN, ART)
+    assert votes.counts.sum(axis=1).tolist() == [4, 4, 4]
+    K = k.similarity(TEST, TRAIN, ART)
+    assert K.shape == (3, 4) and np.all((K >= 0) & (K <= 1))
+    assert K[0].tolist() == [0.5, 0.5, 0.0, 0.0] and K[1].sum() == 0.0 and K[2, 2] == 1.0
+    assert votes.mode() == {"crayons": "paintbrush", "toothbrush": DISTRACTOR, "apple": "banana"}
+    assert votes.agreement() == {"crayons": 0.5, "toothbrush": 1.0, "apple": 1.0}
+    # one call per sample (+1 repair on the first), each with its own seed; the intent is in the prompt
+    user_msgs = [c[0][1].content for c in lm.calls if len(c[0]) == 2]
+    assert len(lm.calls) == 4 + 1 + 4 and k.calls == 8
+    assert all("pack art supplies" in m for m in user_msgs)
+    assert {c[1] for c in lm.calls} == {0, 1, 2, 3}
+    orders = {tuple(_names_in_order(m, "New objects")) for m in user_msgs}
+    assert len(orders) > 1 and all(sorted(o) == sorted(t.name for t in TEST) for o in orders)
+    assert "did not" in lm.calls[1][0][-1].content or "not mapped" in lm.calls[1][0][-1].content
+
+
+def test_lm_no_intent_sends_no_intent_and_gift_requires_one():
+    lm = ScriptedLM(lambda m, s: json.dumps({t.name: "distractor" for t in TEST}))
+    k = NoIntentMappingKernel(lm=lm, samples=2)
+    assert not k.uses_intent and k.similarity(TEST, TRAIN, ART).sum() == 0.0
+    assert all("pack art supplies" not in c[0][1].content and "No goal" in c[0][1].content for c in lm.calls)
+    with pytest.raises(GiftError, match="conditions on an intent"):
+        MappingKernel(lm=lm).similarity(TEST, TRAIN, None)
+    with pytest.raises(GiftError, match="positive integer"):
+        MappingKernel(lm=lm, samples=0)
+
+
+def test_gift_kernel_gives_up_with_the_raw_answer_after_the_repairs():
+    lm = ScriptedLM(lambda m, s: "I think crayons are art.")
+    with pytest.raises(LMAnswerError, match="repair") as e:
+        MappingKernel(lm=lm, samples=1, max_repairs=1).similarity(TEST, TRAIN, ART)
+    assert "crayons are art" in str(e.value) and len(lm.calls) == 2
+
+
+# ----------------------------------------------------------------------------- gift-prob control flow
+
+
+def _probs_by_name(table):
+    def probs(text):
+        name = re.search(r"Is a (.+?) \(", text).group(1)
+        return {"yes": table[name], "no": 1.0 - table[name]}
+    return probs
+
+
+def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
+    table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
+             "toothbrush": 0.4, "apple": 0.05}
+    lm = ScriptedLM(probs=_probs_by_name(table))
+    k = GiftProbKernel(lm=lm, combine="none")
+    lo = k.log_odds(TEST, ART)
+    assert np.allclose(lo, [np.log(0.7 / 0.3), np.log(0.4 / 0.6), np.log(0.05 / 0.95)])
+    r = k.relevance(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
+    assert np.allclose(r, [0.7, 0.4, 0.05])
+    # K: r_i in the relevant columns (given, or the training objects the LM itself calls relevant), 0 elsewhere
+    for K in (k.similarity(TEST, TRAIN, ART), k.similarity(TEST, TRAIN, ART, relevant_train=("paintbrush",
+                                                                                               "sketchbook"))):
+        assert np.allclose(K, np.outer([0.7, 0.4, 0.05], [1, 1, 0, 0]))
+    assert np.allclose(k.loo_relevance(TRAIN, ART, ("paintbrush", "sketchbook")), [0.9, 0.8, 0.2, 0.1])
+    n_calls = len(lm.calls)
+    k.relevance(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
+    assert len(lm.calls) == n_calls  # each question is asked once per kernel
+    assert all(m[0][0].content == prompts.RELEVANCE_SYSTEM for m in lm.calls)
+    assert "pack art supplies" in lm.calls[0][0][1].content and "(sticks of colored wax)" in lm.calls[0][0][1].content
+
+
+def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
+    intent = Intent(text="pack art supplies", axes=(gift.SemanticAxis("is it used to make art?", ("crayons",)),))
+
+    def probs(text):
+        return {"yes": 0.9, "no": 0.1} if text.startswith("is it used to make art?") else {"yes": 0.3, "no": 0.7}
+
+    k = GiftProbKernel(lm=ScriptedLM(probs=probs), combine="none", axes=True)
+    assert np.allclose(k.log_odds(TEST[:1], intent), [np.log(9)])
+    assert np.allclose(GiftProbKernel(lm=ScriptedLM(probs=probs), combine="none").log_odds(TEST[:1], intent),
+                       [np.log(0.3 / 0.7)])
+
+
+def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_options():
+    with pytest.raises(GiftError, match="log-probabilities.*scripted:scripted.*'gift' kernel"):
+        GiftProbKernel(lm=PlainLM(lambda m, s: "{}"), combine="none").relevance(TEST, TRAIN, ART)
+    with pytest.raises(GiftError, match="conditions on an intent"):
+        GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).relevance(TEST, TRAIN, None)
+    for bad in ({"template": "nope"}, {"combine": "mean"}, {"weight": 2.0}, {"embed_reference": "x"},
+                {"standardize": "y"}):
+        with pytest.raises(GiftError, match="gift-prob"):
+            GiftProbKernel(**bad)
+    with pytest.raises(GiftError, match="not training objects"):
+        GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5}), combine="none").similarity(
+            TEST, TRAIN, ART, relevant_train=("ghost",))
+
+
+def test_goal_text_turns_motivation_sentences_into_goal_clauses():
+    assert prompts.goal_text("The human prefers to keep sharp tools away from food.") == \
+        "keep sharp tools away from food"
+    assert prompts.goal_text("pack art supplies") == "pack art supplies"
+
+
+# ----------------------------------------------------------------------------- the embedded model
+
+
+@pytest.fixture(scope="session")
+def embedded_lm():
+    gift_llm = pytest.importorskip("gift_llm")
+    return gift_llm.get_default_lm()
+
+
+@pytest.mark.slow
+def test_gift_prob_on_the_embedded_model_ranks_and_aligns_art_supplies(embedded_lm):
+    suite = load_suite(SUITE)
+    spec = suite.intent("art_supplies")
+    test = suite.specs(["colored pencils", "crayons", "toothbrush", "apple"])
+    train = suite.specs(spec.train_objects)
+    intent = Intent(text=spec.text, source="ground-truth")
+    k = gift.get_kernel("gift-prob", lm=embedded_lm)
+    r = k.relevance(test, train, intent, spec.relevant_train)
+    assert r.shape == (4,) and np.all((r > 0) & (r < 1))
+    assert min(r[:2]) > max(r[2:]), r  # the art supplies above the brush for teeth and the fruit
+    lm_only = GiftProbKernel(lm=embedded_lm, combine="none").log_odds(test, intent)
+    assert lm_only[:2].mean() > lm_only[2:].mean()
+    op = gift.get_alignment_operator("argmax-threshold", threshold="train-calibrated")
+    al = op.align(k, test, train, intent, relevant_train=spec.relevant_train)
+    assert al.target("colored pencils") in spec.relevant_train and al.target("apple") not in spec.relevant_train
+
+
+@pytest.mark.slow
+def test_gift_and_lm_no_intent_on_the_embedded_model_map_every_object_within_the_call_budget(embedded_lm):
+    test = [ObjectSpec("crayons", "sticks of colored wax"), ObjectSpec("apple", "a round red fruit")]
+    k = MappingKernel(lm=embedded_lm, samples=2)
+    votes = k.votes(test, TRAIN, ART)
+    assert votes.counts.sum(axis=1).tolist() == [2, 2]  # every object mapped in every sample
+    assert k.calls == 2  # one call per sample, whatever the number of objects
+    K = k.similarity(test, TRAIN, ART)  # served from the LM cache: same seeds, same prompts
+    assert K.shape == (2, 4) and np.all(np.isin(K, [0.0, 0.5, 1.0]))
+    k0 = gift.get_kernel("lm-no-intent", lm=embedded_lm, samples=1)
+    assert k0.similarity(test, TRAIN, ART).shape == (2, 4) and k0.calls == 1
