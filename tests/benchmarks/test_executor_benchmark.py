@@ -1,15 +1,17 @@
 """Throughput of sweeps on 1 vs 2 workers: serial (the naive baseline), local process pool, Ray.
 
-Two workloads from ``tests/executor/executor_sweeps.py``, 24 seeded items per round:
+Three workloads from ``tests/executor/executor_sweeps.py``, 24 seeded items per round:
 
-- ``rollouts``: trajectory generation (512 synthetic rollouts x 61 steps x 8 features per item; the
-  feature batches travel back to the caller);
-- ``evaluation``: an evaluation sweep that scores fresh rollouts with a fitted ``maxent-linear`` reward
-  (shipped once per chunk) and the ground truth; only the scores travel back.
+- ``drake``: trajectory generation with the Drake simulator ``drake-jaco`` (one scene per item,
+  ``make_scene`` + 32 preferred rollouts + features; the feature batches travel back);
+- ``evaluation``: an evaluation sweep that scores 512 fresh synthetic rollouts per item with a fitted
+  ``maxent-linear`` reward (shipped once per chunk) and the ground truth; only scores travel back;
+- ``cached-lm``: LM questions answered from the LM plugin's SQLite cache at a shared path (4 distinct
+  questions asked 6 times each, cache filled by the embedded llama.cpp model before timing).
 
 Pools are started and warmed before timing (steady-state throughput); ``extra_info`` records items/s.
-Nothing here asserts anything about time; each benchmark checks its results equal the serial ones.
-Run: ``.venv/bin/python -m pytest tests/benchmarks/test_executor_benchmark.py --benchmark-only``.
+Nothing here asserts anything about time; each benchmark checks its results against serial ones.
+Run: ``.venv/bin/python -m pytest tests/benchmarks/test_executor_benchmark.py``.
 """
 
 from __future__ import annotations
@@ -20,14 +22,18 @@ from pathlib import Path
 
 import pytest
 
+import gift
 from gift.core.executor import LocalExecutor, SerialExecutor, get_executor, item_seeds
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "executor"))
 import executor_sweeps as sweeps  # noqa: E402
 
 N_ITEMS = 24
-ROLLOUT_ITEMS = [("place_mug", sweeps.OBJECTS, int(s), 512, 61) for s in item_seeds(100, N_ITEMS)]
+TASKS = ("place_mug", "pack_backpack", "sweep_spill", "store_drawer")
+DRAKE_ITEMS = [("drake-jaco", TASKS[i % 4], ("laptop", "banana", "phone", "keys"), ("laptop", "keys"), int(s), 32)
+               for i, s in enumerate(item_seeds(100, N_ITEMS))]
 EVAL_ITEMS = [("place_mug", sweeps.OBJECTS[:4], int(s), 512, 61) for s in item_seeds(200, N_ITEMS)]
+LM_ITEMS = [(f"Name one {w}.", 0) for w in ("fruit", "color", "tool", "animal")] * (N_ITEMS // 4)
 
 CONFIGS = ["serial", "local-1", "local-2", "ray-1", "ray-2"]
 
@@ -41,9 +47,9 @@ def executors():
         import gift_executor_ray  # noqa: F401
 
         ray_base = get_executor("ray", num_cpus=2)           # starts (and owns) a local Ray instance
+        ray_base.map(abs, [0])
         made["ray-1"] = get_executor("ray", max_workers=1)  # same instance, one task in flight
         made["ray-2"] = get_executor("ray", max_workers=2)
-        ray_base.map(abs, [0])                              # start the instance now
     except ImportError:
         pass
     yield made
@@ -53,28 +59,31 @@ def executors():
         ray_base.close()
 
 
-@pytest.fixture(scope="module")
-def reward():
-    return sweeps.fit_reward()
-
-
-def _run(benchmark, executors, config, fn, items, reference):
+def _run(benchmark, executors, config, fn, items, check):
     ex = executors.get(config)
     if ex is None:
         pytest.skip(f"{config}: gift-executor-ray is not installed")
-    ex.map(fn, items)  # warm the workers (process start, imports) outside the timing
+    ex.map(fn, items)  # warm the workers (process start, imports, plant build) outside the timing
     result = benchmark.pedantic(ex.map, args=(fn, items), rounds=3, iterations=1)
     benchmark.extra_info.update(executor=config, items=len(items),
                                 items_per_s=round(len(items) / benchmark.stats.stats.mean, 2))
-    assert reference(result)
+    assert check(result)
 
 
 @pytest.mark.slow
+@pytest.mark.drake
 @pytest.mark.parametrize("config", CONFIGS)
-def test_rollout_throughput(benchmark, executors, config):
-    expected = [b.values.tobytes() for b in map(sweeps.synthetic_rollouts, ROLLOUT_ITEMS[:2])]
-    _run(benchmark, executors, config, sweeps.synthetic_rollouts, ROLLOUT_ITEMS,
+def test_drake_rollout_throughput(benchmark, executors, config):
+    if "drake-jaco" not in gift.get_manager().names("simulator"):
+        pytest.skip("the drake-jaco simulator (gift-sim-drake) is not registered")
+    expected = [b.values.tobytes() for b in map(sweeps.drake_rollouts, DRAKE_ITEMS[:2])]
+    _run(benchmark, executors, config, sweeps.drake_rollouts, DRAKE_ITEMS,
          lambda res: [b.values.tobytes() for b in res[:2]] == expected and len(res) == N_ITEMS)
+
+
+@pytest.fixture(scope="module")
+def reward():
+    return sweeps.fit_reward()
 
 
 @pytest.mark.slow
@@ -84,3 +93,29 @@ def test_evaluation_sweep_throughput(benchmark, executors, reward, config):
     expected = [s.tobytes() for s, _ in map(fn, EVAL_ITEMS[:2])]
     _run(benchmark, executors, config, fn, EVAL_ITEMS,
          lambda res: [s.tobytes() for s, _ in res[:2]] == expected and len(res) == N_ITEMS)
+
+
+@pytest.fixture(scope="module")
+def filled_lm_cache(tmp_path_factory):
+    """A shared cache path holding the embedded model's answers to the 4 questions (4 real LM calls)."""
+    pytest.importorskip("llama_cpp")
+    from gift.core.errors import LMError
+    from gift_llm.embedded import embedded_model_path
+
+    try:
+        embedded_model_path()
+    except LMError as e:
+        pytest.skip(f"embedded model not installed: {e}")
+    path = str(tmp_path_factory.mktemp("lm-cache") / "lm-cache.sqlite")
+    answers = SerialExecutor().map(functools.partial(sweeps.ask_lm, path, None), LM_ITEMS[:4])
+    return path, [text for text, _ in answers]
+
+
+@pytest.mark.slow
+@pytest.mark.lm
+@pytest.mark.parametrize("config", CONFIGS)
+def test_cached_lm_sweep_throughput(benchmark, executors, filled_lm_cache, config):
+    path, answers = filled_lm_cache
+    want = [(a, True) for a in answers] * (N_ITEMS // 4)
+    _run(benchmark, executors, config, functools.partial(sweeps.ask_lm, path, None), LM_ITEMS,
+         lambda res: res == want)

@@ -131,12 +131,16 @@ def test_serial_local_and_ray_give_identical_bits(local_executor, ray_executor):
 
 @pytest.mark.drake
 @pytest.mark.slow
-def test_drake_trajectory_generation_identical_on_serial_and_local(local_executor):
+def test_drake_trajectory_generation_identical_on_serial_local_and_ray(local_executor, ray_executor):
     if "drake-jaco" not in gift.get_manager().names("simulator"):
-        pytest.skip("the drake-jaco simulator (gift-sim-drake) is not registered yet")
-    items = [("drake-jaco", "place_mug", ("laptop", "banana"), ("laptop",), int(s), 2) for s in item_seeds(1, 4)]
+        pytest.skip("the drake-jaco simulator (gift-sim-drake) is not registered")
+    tasks = ("place_mug", "pack_backpack", "sweep_spill", "store_drawer")
+    items = [("drake-jaco", tasks[i % 4], ("laptop", "banana", "phone"), ("laptop",), int(s), 3)
+             for i, s in enumerate(item_seeds(1, 6))]
     ref = as_bytes(SerialExecutor().map(sweeps.drake_rollouts, items))
+    assert len({r[3] for r in ref}) == len(ref)  # six different scenes
     assert as_bytes(local_executor.map(sweeps.drake_rollouts, items)) == ref
+    assert as_bytes(ray_executor.map(sweeps.drake_rollouts, items)) == ref
 
 
 # ------------------------------------------------------------------ order and failures
