@@ -99,18 +99,27 @@ class ArmKinematics:
                    base_link, ee_link)
 
     @cached_property
-    def _axis_cross(self) -> np.ndarray:
-        """Skew matrices ``[dof, 3, 3]`` of the joint axes (for Rodrigues' formula)."""
-        k = np.zeros((self.dof, 3, 3))
-        for i, (x, y, z) in enumerate(self.axes):
-            k[i] = [[0, -z, y], [z, 0, -x], [-y, x, 0]]
-        return k
-
-    def _joint_rotation(self, i: int, q: np.ndarray) -> np.ndarray:
-        """Rotation ``[..., 3, 3]`` of joint ``i`` by angles ``q`` ``[...]``."""
-        k = self._axis_cross[i]
-        s, c = np.sin(q)[..., None, None], np.cos(q)[..., None, None]
-        return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    def _z_chain(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The chain rewritten so every joint turns about its local z axis: ``(rot [dof, 3, 3],
+        trans [dof, 3], tool_rot [3, 3], tool_trans [3])`` (each joint frame is turned by a constant
+        rotation taking z onto the joint's axis; the next origin undoes it)."""
+        align = []
+        for axis in self.axes:
+            v = np.cross([0.0, 0.0, 1.0], axis)
+            c = float(axis[2])
+            if np.linalg.norm(v) < 1e-12:
+                align.append(np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0]))
+                continue
+            k = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+            align.append(np.eye(3) + k + k @ k / (1.0 + c))
+        rots, trans = [], []
+        undo = np.eye(3)
+        for i in range(self.dof):
+            o = self.origins[i]
+            rots.append(undo @ o[:3, :3] @ align[i])
+            trans.append(undo @ o[:3, 3])
+            undo = align[i].T
+        return np.array(rots), np.array(trans), undo @ self.tool[:3, :3], undo @ self.tool[:3, 3]
 
     def frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Chain quantities for ``q`` ``[..., dof]``.
@@ -122,20 +131,31 @@ class ArmKinematics:
         if q.shape[-1] != self.dof:
             raise GiftError(f"joint positions must end in dof={self.dof}, got shape {q.shape}")
         shape = q.shape[:-1]
-        rot = np.broadcast_to(np.eye(3), shape + (3, 3))
-        pos = np.zeros(shape + (3,))
-        jpos = np.empty(shape + (self.dof, 3))
-        jaxis = np.empty(shape + (self.dof, 3))
+        qf = q.reshape(-1, self.dof)
+        m = qf.shape[0]
+        rots, trans, tool_rot, tool_trans = self._z_chain
+        # the rotation as its three columns [m, 3] each: only elementwise products, no tiny matmuls
+        cols = [np.broadcast_to(e, (m, 3)) for e in np.eye(3)]
+        pos = np.zeros((m, 3))
+        jpos = np.empty((m, self.dof, 3))
+        jaxis = np.empty((m, self.dof, 3))
+        cos, sin = np.cos(qf)[:, :, None], np.sin(qf)[:, :, None]
+
+        def times_const(cols, r):
+            return [cols[0] * r[0, j] + cols[1] * r[1, j] + cols[2] * r[2, j] for j in range(3)]
+
         for i in range(self.dof):
-            o = self.origins[i]
-            pos = pos + rot @ o[:3, 3]
-            rot = rot @ o[:3, :3]
-            jpos[..., i, :] = pos
-            jaxis[..., i, :] = rot @ self.axes[i]
-            rot = rot @ self._joint_rotation(i, q[..., i])
-        pos = pos + rot @ self.tool[:3, 3]
-        rot = rot @ self.tool[:3, :3]
-        return jpos, jaxis, pos, rot
+            t = trans[i]
+            pos = pos + cols[0] * t[0] + cols[1] * t[1] + cols[2] * t[2]
+            x, y, z = times_const(cols, rots[i])
+            jpos[:, i] = pos
+            jaxis[:, i] = z
+            c, s = cos[:, i], sin[:, i]
+            cols = [c * x + s * y, c * y - s * x, z]
+        pos = pos + cols[0] * tool_trans[0] + cols[1] * tool_trans[1] + cols[2] * tool_trans[2]
+        rot = np.stack(times_const(cols, tool_rot), axis=-1)
+        return (jpos.reshape(shape + (self.dof, 3)), jaxis.reshape(shape + (self.dof, 3)), pos.reshape(shape + (3,)),
+                rot.reshape(shape + (3, 3)))
 
     def fk(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """End-effector position ``[..., 3]`` (m) and rotation ``[..., 3, 3]`` for ``q`` ``[..., dof]``."""
