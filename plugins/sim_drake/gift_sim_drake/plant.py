@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -37,6 +38,8 @@ CONTAINERS = {
     "drawer": {"footprint": (0.30, 0.34), "height": 0.12, "wall": 0.015, "color": (0.55, 0.38, 0.22)},
 }
 SPILL_RADIUS = 0.09
+#: Drake IK solutions kept per arm (oldest dropped first).
+IK_CACHE_SIZE = 50_000
 MUG = Appearance(shape="cylinder", size=(0.04, 0.10), color=(0.95, 0.95, 0.92))
 
 
@@ -189,7 +192,7 @@ class DrakeIK:
         self.position_tolerance = position_tolerance
         self.angle_tolerance = angle_tolerance
         self.max_step = max_step
-        self._cache: dict[tuple, np.ndarray] = {}
+        self._cache: OrderedDict[tuple, np.ndarray] = OrderedDict()
         self._lock = threading.Lock()
 
     def solve(self, target: Sequence[float], guess: Sequence[float]) -> np.ndarray:
@@ -214,6 +217,8 @@ class DrakeIK:
         sol = np.asarray(result.GetSolution(q), dtype=float)
         with self._lock:
             self._cache[key] = sol
+            while len(self._cache) > IK_CACHE_SIZE:
+                self._cache.popitem(last=False)
         return sol.copy()
 
     def _solve_once(self, target: np.ndarray, guess: np.ndarray):

@@ -30,7 +30,17 @@ def as_object_specs(objects: Sequence[ObjectSpec | str]) -> tuple[ObjectSpec, ..
 
 
 class DrakeSimulator(Simulator):
-    """Tabletop scenes of the four task families for one arm, on Drake."""
+    """Tabletop scenes of the four task families for one arm, on Drake.
+
+    - ``make_scene(task, objects, relevant, seed)``: a randomised layout (:mod:`gift_sim_drake.scenes`);
+      ``scene.landmarks`` holds the family's landmark (``backpack``/``drawer``: the place point inside the
+      container; ``spill``: the spill's centre on the table; ``mug``: the mug's start) and, for place_mug,
+      ``mug_goal``.
+    - ``generate(scene, generator, n, seed)``: ``generator`` in ``("preferred", "default", "random")``
+      (:mod:`gift_sim_drake.motion`); every trajectory acts on one thing, named in ``meta["acted_on"]``.
+    - ``features(trajectories, task)``: the family's feature columns ``[N, 61, F]``.
+    - ``render_object(obj, size)``: ``[3, size, size, 3]`` uint8 views, cached on disk.
+    """
 
     robot_name: ClassVar[str] = "franka"
     n_steps = N_STEPS
