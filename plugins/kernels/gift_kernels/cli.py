@@ -134,10 +134,14 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
     thresholds = [t.strip() for t in args.threshold.split(",") if t.strip()]
     intents = [i.strip() for i in args.intents.split(",")] if args.intents else None
     progress = None if args.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))
+    def write(result: dict) -> None:  # after every kernel x intent: an interrupted run keeps its numbers
+        tmp = Path(str(args.out) + ".tmp")
+        tmp.write_text(json.dumps(result, indent=2), encoding="utf-8")
+        tmp.replace(args.out)
+
     result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
-                                lm=args.lm, intents=intents, progress=progress)
-    if args.out:
-        Path(args.out).write_text(json.dumps(result, indent=2), encoding="utf-8")
+                                lm=args.lm, intents=intents, progress=progress,
+                                checkpoint=write if args.out else None)
     print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
     failed = [k for k, d in result["kernels"].items() if d["errors"]]
     return 1 if len(failed) == len(kernels) else 0

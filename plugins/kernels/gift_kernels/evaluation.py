@@ -163,8 +163,12 @@ def _create(kind: str, name: str, lm: str | None, **options: Any) -> Any:
 def evaluate_kernel(kernel: Any, suite: Suite, *, thresholds: Sequence[str] = THRESHOLDS,
                     intent_for: Callable[[IntentSpec, Suite], Intent] = lambda s, _: ground_truth_intent(s),
                     kernel_name: str | None = None, intents: Sequence[str] | None = None,
-                    progress: Callable[[str], None] | None = None) -> KernelResult:
-    """Evaluate one kernel instance on every intent of ``suite`` (or the ids in ``intents``)."""
+                    progress: Callable[[str], None] | None = None,
+                    on_intent: Callable[[KernelResult], None] | None = None) -> KernelResult:
+    """Evaluate one kernel instance on every intent of ``suite`` (or the ids in ``intents``).
+
+    ``on_intent(partial)`` gets the result so far after every intent (to checkpoint long LM runs).
+    """
     name = kernel_name or getattr(kernel, "name", type(kernel).__name__)
     results, errors = [], {}
     specs = [s for s in suite.intents if intents is None or s.id in intents]
@@ -187,11 +191,15 @@ def evaluate_kernel(kernel: Any, suite: Suite, *, thresholds: Sequence[str] = TH
                 progress(f"{name} / {spec.id}: FAILED {type(e).__name__}: {e}")
             if not isinstance(e, GiftError):
                 errors[spec.id] += "\n" + traceback.format_exc(limit=4)
+            if on_intent:
+                on_intent(KernelResult(name, tuple(results), dict(errors), pooled_metrics(suite, results, thresholds)))
             continue
         results.append(IntentResult(spec.id, scores, cuts, metrics, intent.text, time.perf_counter() - t0))
         if progress:
             f1 = " ".join(f"{t}={metrics[t]['all']['f1']:.2f}" for t in thresholds)
             progress(f"{name} / {spec.id}: F1 {f1} ({time.perf_counter() - t0:.1f}s)")
+        if on_intent:
+            on_intent(KernelResult(name, tuple(results), dict(errors), pooled_metrics(suite, results, thresholds)))
     return KernelResult(name, tuple(results), errors, pooled_metrics(suite, results, thresholds))
 
 
@@ -223,8 +231,13 @@ def _value(v: str) -> Any:
 def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds: Sequence[str] = THRESHOLDS,
                        intent_source: str = "ground-truth", lm: str | None = None,
                        intents: Sequence[str] | None = None,
-                       progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict."""
+                       progress: Callable[[str], None] | None = None,
+                       checkpoint: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+    """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
+
+    ``checkpoint(result_so_far)`` is called after every kernel x intent (e.g. to write a file), so an
+    interrupted run keeps what it computed.
+    """
     if isinstance(suite, str):
         suite = load_suite(suite)
     bad = [t for t in thresholds if t not in THRESHOLDS]
@@ -259,12 +272,22 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                                     "intents": {}}
             if progress:
                 progress(f"{spec}: FAILED to build: {type(e).__name__}: {e}")
+            if checkpoint:
+                checkpoint(out)
             continue
+
+        def save(partial: KernelResult, spec: str = spec) -> None:
+            out["kernels"][spec] = partial.as_dict()
+            if checkpoint:
+                checkpoint(out)
+
         res = evaluate_kernel(kernel, suite, thresholds=thresholds, intent_for=intent_for, kernel_name=spec,
-                              intents=intents, progress=progress)
+                              intents=intents, progress=progress, on_intent=save)
         d = res.as_dict()
         d["seconds"] = round(time.perf_counter() - t0, 2)
         out["kernels"][spec] = d
+        if checkpoint:
+            checkpoint(out)
     return out
 
 
