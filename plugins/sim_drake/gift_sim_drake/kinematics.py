@@ -162,7 +162,7 @@ class ArmKinematics:
         _, _, pos, rot = self.frames(q)
         return pos, rot
 
-    def solve_pointing_down(self, q0: np.ndarray, targets: np.ndarray, *, iterations: int = 12,
+    def solve_pointing_down(self, q0: np.ndarray, targets: np.ndarray, *, iterations: int = 20,
                             damping: float = 1e-3, tol: float = 1e-5) -> tuple[np.ndarray, np.ndarray]:
         """Local IK, batched: move ``q0`` ``[M, dof]`` so that the end effector reaches ``targets`` ``[M, 3]``
         with its approach axis (ee z) pointing straight down.

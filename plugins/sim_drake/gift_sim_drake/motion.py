@@ -89,7 +89,8 @@ def build_actions(scene: Scene) -> ActionSet:
         for p in pos:
             lift = np.array([p[0], p[1], max(p[2] + 0.15, 0.25)])
             transit = np.array([(p[0] + c[0]) / 2, (p[1] + c[1]) / 2, max(lift[2], above[2]) + 0.03])
-            targets.append([p + [0, 0, 0.12], p, lift, transit, above, c])
+            grasp = np.array([p[0], p[1], max(p[2], 0.02)])  # thin objects: keep the fingers off the table
+            targets.append([grasp + [0, 0, 0.12], grasp, lift, transit, above, c])
         return ActionSet(np.array(targets), (12, 20, 30, 40, 50, 60), np.arange(len(pos)), 1, None, False,
                          tuple(f"put {n} into the {mark}" for n in names),
                          nominal_target(scene.task, pos, dict(scene.landmarks)))
