@@ -10,7 +10,7 @@ import gift
 from gift.core.alignment import align_state
 from gift.core.data import DISTRACTOR, Alignment, FeatureBatch
 from gift.core.metrics import boltzmann, pairwise_win_rate
-from gift_rewards import LinearMaxEntReward, NeuralMaxEntReward
+from gift_rewards import LinearMaxEntReward, NeuralMaxEntReward, aggregate
 
 TRAIN = ("paintbrush", "sketchbook", "banana", "coffee mug")
 RELEVANT = ("paintbrush", "sketchbook")  # intent: pack the art supplies
@@ -95,6 +95,8 @@ def test_score_matches_columns_by_name():
     specs = random_specs(3)
     reward = LinearMaxEntReward().fit(random_traces(specs, 50, 11, rng), random_traces(specs, 200, 11, rng))
     test = random_traces(specs, 20, 11, rng)
+    # R_θ(ξ) = θ · φ(ξ) with the φ the model was fitted on
+    np.testing.assert_allclose(reward.score(test), aggregate(test.values) @ reward.theta, rtol=1e-12)
     order = [3, 1, 0, 2]
     permuted = FeatureBatch([specs[i] for i in order], test.values[..., order])
     np.testing.assert_allclose(reward.score(permuted), reward.score(test), rtol=0, atol=1e-12)

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.special import logsumexp, softmax
 
+from gift.core.alignment import AlignmentPlan
 from gift.core.errors import GiftError, ValidationError
 from gift_rewards.maxent_base import MaxEntReward, uniform_log_weights
 from gift_rewards.trajectory_features import aggregate, aggregate_names
@@ -74,7 +75,21 @@ class LinearMaxEntReward(MaxEntReward):
                 "optimizer_message": str(res.message)}
 
     def _score(self, values: np.ndarray) -> np.ndarray:
-        return aggregate(values) @ self.theta
+        return _linear_returns(values, self.theta)
+
+    def _score_aligned(self, values: np.ndarray, plan: AlignmentPlan) -> np.ndarray:
+        """θ · φ(f_ω(ξ')) without building the aligned batch when the remap is one-to-one.
+
+        φ works column by column (mean over time, last step), so φ(f_ω(ξ')) is φ(ξ') with its columns
+        remapped: moving θ onto the test columns gives the same number from one pass over the test values.
+        """
+        if not plan.one_to_one:  # several test objects share a training slot: combined by max per state
+            return super()._score_aligned(values, plan)
+        f_train, f_test = len(self.feature_specs), values.shape[2]
+        theta = np.zeros(2 * f_test)
+        theta[plan.src] = self.theta[:f_train][plan.dst]
+        theta[f_test + plan.src] = self.theta[f_train:][plan.dst]
+        return _linear_returns(values, theta)
 
     def _params_to_json(self) -> dict[str, Any]:
         return {"theta": self.theta.tolist(), "names": list(aggregate_names(self.feature_names))}
@@ -84,3 +99,15 @@ class LinearMaxEntReward(MaxEntReward):
         if theta.shape != (2 * len(self.feature_specs),):
             raise ValueError(f"theta has shape {theta.shape}, expected ({2 * len(self.feature_specs)},)")
         self.theta = theta
+
+
+def _linear_returns(values: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """θ · φ(ξ) for ``values`` ``[N, T, F]`` and ``theta`` ``[2F]``, as one matrix-vector product.
+
+    θ · (mean_t x_t, x_T) = Σ_t w_t · x_t with w_t = θ_mean / T, plus θ_final at t = T: a single pass
+    over the contiguous ``[N, T·F]`` values (cheaper than reducing over the time axis first).
+    """
+    n, t, f = values.shape
+    w = np.repeat(theta[None, :f] / t, t, axis=0)
+    w[-1] += theta[f:]
+    return np.ascontiguousarray(values).reshape(n, t * f) @ w.ravel()

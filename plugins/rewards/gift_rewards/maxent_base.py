@@ -26,6 +26,7 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
+from gift.core.alignment import AlignmentPlan, plan_alignment
 from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec
 from gift.core.errors import GiftError, ValidationError
 from gift.core.interfaces import RewardModel
@@ -131,8 +132,8 @@ class MaxEntReward(RewardModel):
     def score_aligned(self, features: FeatureBatch, alignment: Alignment) -> np.ndarray:
         """R̃_θ(ξ' | ω) = R_θ(f_ω(ξ')) for N test trajectories ``[N, T, F_test]``: ``[N]``.
 
-        f_ω is the core's feature-column remap (:func:`gift.core.alignment.align_features`): one gather
-        over the whole batch, no per-state loop.
+        f_ω is the core's feature-column remap (:func:`gift.core.alignment.plan_alignment`, the plan behind
+        :func:`~gift.core.alignment.align_features`) applied to the whole batch at once: no per-state loop.
         """
         where = f"{self.name}.score_aligned(features)"
         check_batch(features, where)
@@ -148,7 +149,16 @@ class MaxEntReward(RewardModel):
         if missing:
             raise ValidationError(f"{where}: the test features lack the continuous column(s) {missing} "
                                   f"the reward was trained on (test columns: {list(features.names)})")
-        return super().score_aligned(features, alignment)
+        plan = plan_alignment(features.specs, dict(alignment.mapping), self.feature_specs)
+        return self._score_aligned(np.asarray(features.values), plan)
+
+    def _score_aligned(self, values: np.ndarray, plan: AlignmentPlan) -> np.ndarray:
+        """R_θ(f_ω(ξ')) of test values ``[N, T, F_test]`` under the core's column ``plan``: ``[N]``.
+
+        Default: apply the remap to the whole batch (as :func:`align_features` does), then score.
+        Subclasses may fold the remap into their parameters instead.
+        """
+        return self._score(plan.apply(values))
 
     def _training_columns(self, features: FeatureBatch, where: str) -> np.ndarray:
         """``[N, T, F_train]`` values of ``features`` in training column order."""
