@@ -23,7 +23,9 @@ logging.getLogger("drake").setLevel(logging.ERROR)
 #: :data:`FRAMING` times the radius of the object's bounding sphere, so every object fills the view alike.
 VIEWPOINTS = ((1.0, 0.0, 0.4), (0.1, 1.0, 0.45), (0.55, 0.45, 0.9))
 FRAMING = 3.2
-RENDER_VERSION = 2
+RENDER_VERSION = 3
+#: Background colour (RGB in [0, 1]): mid grey, so that white and black objects both stand out.
+BACKGROUND = (0.5, 0.5, 0.5)
 _LOCK = threading.Lock()
 
 
@@ -80,7 +82,7 @@ def _draw(appearance: Appearance, size: int) -> np.ndarray:
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     params = RenderEngineVtkParams()
     params.backend = "EGL"
-    params.default_clear_color = [1.0, 1.0, 1.0]
+    params.default_clear_color = list(BACKGROUND)
     scene_graph.AddRenderer("vtk", MakeRenderEngineVtk(params))
     plant.RegisterVisualGeometry(plant.world_body(), RigidTransform(), shape_of(appearance), "object",
                                  np.array([*appearance.color, 1.0]))
@@ -110,7 +112,7 @@ def _draw(appearance: Appearance, size: int) -> np.ndarray:
 
 def render_object(obj: ObjectSpec | Appearance, size: int = 224,
                   cache_dir: str | os.PathLike | None = None) -> np.ndarray:
-    """Images ``[3, size, size, 3]`` uint8 RGB of one object alone on white, from :data:`VIEWPOINTS`."""
+    """Images ``[3, size, size, 3]`` uint8 RGB of one object alone on :data:`BACKGROUND`, from :data:`VIEWPOINTS`."""
     appearance = obj.appearance if isinstance(obj, ObjectSpec) else obj
     if not isinstance(appearance, Appearance):
         raise GiftError(f"render_object needs an ObjectSpec or Appearance, got {type(obj).__name__}")
