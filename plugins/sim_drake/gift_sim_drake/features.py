@@ -37,25 +37,22 @@ def compute_features(trajectories: TrajectoryBatch, task: str | Task) -> Feature
     family = resolve_task(task)
     specs = family.feature_specs(trajectories.object_names)
     n, t = trajectories.joint_positions.shape[:2]
-    names = list(trajectories.object_names) + list(trajectories.landmark_names)
-    index = {name: i for i, name in enumerate(names)}
-    if trajectories.landmark_names:
-        points = np.concatenate([trajectories.object_positions, trajectories.landmark_positions], axis=2)
-    else:
-        points = trajectories.object_positions
-    values = np.empty((n, t, len(specs)))
-    prox_cols, a_idx, b_idx = [], [], []
     ee = trajectories.ee_positions
-    for j, spec in enumerate(specs):
+    where = {name: trajectories.object_positions[:, :, i] for i, name in enumerate(trajectories.object_names)}
+    for i, name in enumerate(trajectories.landmark_names):
+        where.setdefault(name, trajectories.landmark_positions[:, :, i])
+    values = np.empty((n, t, len(specs)))
+    for j, spec in enumerate(specs):  # a handful of columns, each vectorized over [N, T]
         if spec.kind == "proximity":
             for who in (spec.subject, spec.reference):
-                if who not in index:
+                if who not in where:
                     raise GiftError(f"feature {spec.name!r} of task {family.name!r} needs the position of {who!r}, "
                                     f"which this trajectory batch lacks (objects {list(trajectories.object_names)}, "
                                     f"landmarks {list(trajectories.landmark_names)})")
-            prox_cols.append(j)
-            a_idx.append(index[spec.subject])
-            b_idx.append(index[spec.reference])
+            diff = where[spec.subject] - where[spec.reference]
+            dist = np.sqrt(np.einsum("ntk,ntk->nt", diff, diff))
+            absent = np.isnan(dist)
+            values[..., j] = proximity(np.where(absent, np.inf, dist), ~absent) if absent.any() else proximity(dist)
         elif spec.kind == "ee_height":
             values[..., j] = np.clip(ee[..., 2] / EE_HEIGHT_SCALE, 0.0, 1.0)
         elif spec.kind == "ee_speed":
@@ -65,11 +62,6 @@ def compute_features(trajectories: TrajectoryBatch, task: str | Task) -> Feature
         else:
             raise GiftError(f"feature {spec.name!r} of task {family.name!r} has kind {spec.kind!r}; the Drake "
                             f"simulator computes kinds 'proximity', 'ee_height' and 'ee_speed'")
-    if prox_cols:
-        diff = points[:, :, a_idx, :] - points[:, :, b_idx, :]  # [N, T, P, 3]
-        dist = np.sqrt(np.einsum("ntpk,ntpk->ntp", diff, diff))
-        present = ~np.isnan(dist)
-        values[..., prox_cols] = proximity(np.where(present, dist, np.inf), present)
     return FeatureBatch(specs, values, {"task": family.name, **{k: v for k, v in trajectories.meta.items()
                                                                 if k in ("robot", "generator", "seed")}})
 
