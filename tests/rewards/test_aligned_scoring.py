@@ -78,12 +78,16 @@ def test_pack_alignment_decides_the_ranking(pack, pack_reward):
 
 
 @pytest.mark.parametrize("model_cls", [LinearMaxEntReward, NeuralMaxEntReward])
-def test_vectorized_alignment_equals_state_by_state(pack, pack_training, model_cls):
+@pytest.mark.parametrize("mapping", [
+    {"molding clay": "paintbrush", "toothbrush": DISTRACTOR, "stapler": "banana"},
+    {"molding clay": "paintbrush", "toothbrush": "paintbrush", "stapler": "coffee mug"},  # two share a slot
+], ids=["one-to-one", "many-to-one"])
+def test_vectorized_alignment_equals_state_by_state(pack, pack_training, model_cls, mapping):
     reward = model_cls(**({"max_epochs": 40} if model_cls is NeuralMaxEntReward else {})).fit(*pack_training)
     rng = np.random.default_rng(3)
     objects = ("molding clay", "toothbrush", "stapler")
     test = pack_traces(pack, objects, rng.random((12, 3)) < 0.5, N_STEPS, rng)
-    alignment = Alignment({"molding clay": "paintbrush", "toothbrush": DISTRACTOR, "stapler": "banana"})
+    alignment = Alignment(mapping)
     naive = np.array([[align_state(state, test.specs, alignment, reward.feature_specs) for state in trace]
                       for trace in test.values])
     expected = reward.score(FeatureBatch(reward.feature_specs, naive))

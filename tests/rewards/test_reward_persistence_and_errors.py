@@ -130,6 +130,11 @@ def test_score_aligned_rejects_bad_alignments(fitted, data):
     with pytest.raises(ValidationError, match=r"maps \{'obj0': 'pencil'\} to objects this reward was not "
                                               r"trained on"):
         fitted.score_aligned(test, Alignment({"obj0": "pencil"}))
+    drawer = FeatureBatch((FeatureSpec("cup_proximity_to_drawer", subject="cup", reference="drawer"),) + SPECS[3:],
+                          test.values[..., 2:])
+    with pytest.raises(ValidationError, match=r"test column\(s\) \['cup_proximity_to_drawer \(cup -> obj0\)'\] "
+                                              r"have no counterpart of the same kind and reference"):
+        fitted.score_aligned(drawer, Alignment({"cup": "obj0"}))
     with pytest.raises(ValidationError, match="expected an Alignment, got dict"):
         fitted.score_aligned(test, {"obj0": "obj1"})
     with pytest.raises(ValidationError, match=r"score_aligned\(features\): the test features lack the "

@@ -144,6 +144,14 @@ class MaxEntReward(RewardModel):
         if bad:
             raise ValidationError(f"{where}: the alignment maps {bad} to objects this reward was not trained on "
                                   f"(training objects: {sorted(train_subjects)})")
+        roles = {(s.subject, s.role) for s in self.feature_specs if s.semantic}
+        unmatched = [f"{s.name} ({s.subject} -> {alignment.target(s.subject)})" for s in features.specs
+                     if s.semantic and alignment.target(s.subject) != DISTRACTOR
+                     and (alignment.target(s.subject), s.role) not in roles]
+        if unmatched:
+            raise ValidationError(f"{where}: test column(s) {unmatched} have no counterpart of the same kind and "
+                                  f"reference among the reward's columns {list(self.feature_names)} "
+                                  f"(features of another task?)")
         test_names = set(features.names)
         missing = [s.name for s in self.feature_specs if not s.semantic and s.name not in test_names]
         if missing:
