@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 import gift
-from gift.core.alignment import align_features
-from gift.core.data import Alignment, ObjectSpec
+from gift.core.data import ObjectSpec
 from gift.core.errors import GiftError
 from gift_sim_drake.motion import N_STEPS
 from gift_sim_drake.plant import SceneModel
@@ -151,3 +150,16 @@ def test_bad_input_gets_clear_errors(simulators, objects):
         sim.make_scene("sweep_spill", [ObjectSpec(f"o{i}") for i in range(7)], [], seed=0)
     with pytest.raises(gift.core.errors.ValidationError, match="not in the scene"):
         sim.make_scene("pack_backpack", objects, ["unicorn"], seed=0)
+    with pytest.raises(GiftError, match="lacks object positions or the landmarks"):
+        sim.generate(gift.Scene("place_mug", objects), "default", 2, seed=0)
+
+
+def test_scene_model_poses_a_generated_state(simulators, objects):
+    sim = simulators["drake-franka"]
+    scene = sim.make_scene("place_mug", objects, RELEVANT, seed=4)
+    b = sim.generate(scene, "preferred", 2, seed=0)
+    model = sim.scene_model(scene)
+    state = {name: b.object_positions[1, 30, i] for i, name in enumerate(b.object_names)}
+    model.set_state(b.joint_positions[1, 30], {**state, "mug": b.landmark_positions[1, 30, 0]})
+    assert np.abs(model.ee_position() - b.ee_positions[1, 30]).max() < 1e-6
+    assert np.abs(model.body_position("mug") - b.landmark_positions[1, 30, 0]).max() < 1e-9

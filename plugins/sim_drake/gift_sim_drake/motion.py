@@ -77,9 +77,20 @@ class ActionSet:
         return self.times[0] != 0
 
 
+def check_scene(scene: Scene) -> str:
+    """The family's landmark, after checking ``scene`` has what motion needs (else a clear error)."""
+    mark = check_family(scene.task)
+    need = {"mug": ("mug", "mug_goal")}.get(mark, (mark,))
+    missing = [k for k in need if k not in scene.landmarks]
+    if missing or np.asarray(scene.positions).shape != (len(scene.objects), 3) or not scene.objects:
+        raise GiftError(f"this {scene.task} scene (seed {scene.seed}) lacks object positions or the landmarks "
+                        f"{list(need)} (missing {missing}); build scenes with the simulator's make_scene")
+    return mark
+
+
 def build_actions(scene: Scene) -> ActionSet:
     """The candidate actions of ``scene`` (see the module docstring)."""
-    mark = check_family(scene.task)
+    mark = check_scene(scene)
     pos = np.asarray(scene.positions)
     names = scene.object_names
     if mark in CONTAINERS:

@@ -19,8 +19,8 @@ from gift_sim_drake.robots import RobotSpec
 
 logging.getLogger("drake").setLevel(logging.ERROR)
 
-from pydrake.geometry import Box, Cylinder, SceneGraph, Sphere  # noqa: E402
-from pydrake.math import RigidTransform, RotationMatrix  # noqa: E402
+from pydrake.geometry import Box, Cylinder, Sphere  # noqa: E402
+from pydrake.math import RigidTransform  # noqa: E402
 from pydrake.multibody.inverse_kinematics import InverseKinematics  # noqa: E402
 from pydrake.multibody.parsing import Parser  # noqa: E402
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction, MultibodyPlant  # noqa: E402

@@ -65,6 +65,15 @@ class DrakeSimulator(Simulator):
     def features(self, trajectories: TrajectoryBatch, task: str | Task) -> FeatureBatch:
         return compute_features(trajectories, task)
 
+    def scene_model(self, scene: Scene):
+        """A Drake diagram of ``scene`` (:class:`gift_sim_drake.plant.SceneModel`): table, this arm, the
+        landmarks and the objects as free bodies, e.g. to check a trajectory state on the real plant."""
+        from gift_sim_drake.motion import check_scene
+        from gift_sim_drake.plant import SceneModel
+
+        check_scene(scene)
+        return SceneModel(self.robot, scene.task, scene.objects, scene.landmarks)
+
     def render_object(self, obj: ObjectSpec, size: int = 224) -> np.ndarray:
         from gift_sim_drake.render import render_object
 
