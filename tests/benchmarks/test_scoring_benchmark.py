@@ -3,15 +3,15 @@
 10,000 test trajectories × 61 steps of the real ``pack_backpack`` feature columns for four test objects,
 aligned to a reward learned on four training objects:
 
-- ``vectorized``: :meth:`RewardModel.score_aligned` — f_ω as one column remap of the ``[N, T, F]`` batch,
-  then one batched R_θ call;
+- ``vectorized``: :meth:`RewardModel.score_aligned` — f_ω as one column remap of the ``[N, T, F]`` batch
+  (for the linear reward folded into θ, so scoring is one matrix-vector product), then one batched R_θ;
 - ``naive-per-state``: f_ω applied state by state (:func:`gift.core.alignment.align_state`), then R_θ of
   each aligned trajectory — the paper's formulation written as a loop.
 
 Both run in the same session for ``maxent-linear``; its vectorized test records ``speedup_vs_naive``
 (ratio of median times) in ``extra_info`` and prints it. ``maxent-neural`` is timed on the vectorized
-path only (its per-trajectory loop would cost the same alignment work). Nothing asserts anything about time; every path checks its scores
-against the other. Run: ``.venv/bin/python -m pytest tests/benchmarks/test_scoring_benchmark.py``.
+path only (its per-trajectory loop would cost the same alignment work). Nothing asserts anything about
+time; every path checks its scores against the other. Run: ``.venv/bin/python -m pytest tests/benchmarks/test_scoring_benchmark.py``.
 """
 
 from __future__ import annotations
