@@ -11,7 +11,8 @@ aligned to a reward learned on four training objects:
 Both run in the same session for ``maxent-linear``; its vectorized test records ``speedup_vs_naive``
 (ratio of median times) in ``extra_info`` and prints it. ``maxent-neural`` is timed on the vectorized
 path only (its per-trajectory loop would cost the same alignment work). Nothing asserts anything about
-time; every path checks its scores against the other. Run: ``.venv/bin/python -m pytest tests/benchmarks/test_scoring_benchmark.py``.
+time; every path checks its scores against the other.
+Run: ``.venv/bin/python -m pytest tests/benchmarks/test_scoring_benchmark.py``.
 """
 
 from __future__ import annotations
