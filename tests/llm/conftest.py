@@ -23,10 +23,10 @@ def embedded_gguf() -> Path:
 
 @pytest.fixture(scope="session")
 def embedded_lm(embedded_gguf):
-    """The raw (uncached) llamacpp backend on the embedded model; the GGUF is loaded once per session."""
-    from gift_llm.backends.llamacpp import LlamaCppLM
+    """The raw (uncached) llamacpp backend on the embedded model; the GGUF is loaded once per process."""
+    from gift_llm import get_default_lm
 
-    lm = LlamaCppLM(embedded_gguf, n_ctx=2048)
+    lm = get_default_lm(cache=False).inner  # the same shared Llama that get_default_lm() uses
     lm.llama  # noqa: B018 - load now so the first test does not pay for it alone
     return lm
 

@@ -9,7 +9,8 @@ from typing import Any
 
 from gift.core.errors import LMError
 from gift.core.interfaces import LMBackend
-from gift_llm.cache import CachedLM
+from gift_llm.cache import CachedLM, cache_enabled_by_env
+from gift_llm.paths import lm_cache_path
 from gift_llm.replay import RecordingLM
 
 _DEFAULTS: dict[tuple, CachedLM] = {}
@@ -29,11 +30,12 @@ def get_default_lm(**options: Any) -> LMBackend:
 
     wrap = {k: options.pop(k) for k in _WRAPPER_KEYS if k in options}
     path = Path(options.pop("model", None) or embedded_model_path()).resolve()
-    key = (str(path), tuple(sorted(options.items())), wrap.get("cache", True), str(wrap.get("cache_path")))
+    enabled = bool(wrap.get("cache", True)) and cache_enabled_by_env()
+    cache_path = Path(wrap.get("cache_path") or lm_cache_path()) if enabled else None
+    key = (str(path), tuple(sorted(options.items())), str(cache_path))
     with _DEFAULTS_LOCK:
         if key not in _DEFAULTS:
-            _DEFAULTS[key] = CachedLM(LlamaCppLM(path, **options), path=wrap.get("cache_path"),
-                                      enabled=bool(wrap.get("cache", True)))
+            _DEFAULTS[key] = CachedLM(LlamaCppLM(path, **options), path=cache_path, enabled=enabled)
         lm: LMBackend = _DEFAULTS[key]
     return _record(lm, wrap.get("record"))
 
