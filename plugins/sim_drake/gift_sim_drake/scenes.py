@@ -32,7 +32,7 @@ def check_family(task: str) -> str:
     return FAMILIES[task]
 
 
-def _place(rng: np.random.Generator, radii: np.ndarray, sample, what: str, restarts: int = 30,
+def _place(rng: np.random.Generator, radii: np.ndarray, sample, what: str, restarts: int = 200,
            tries: int = 60) -> np.ndarray:
     """Rejection-sample non-overlapping xy positions ``[n, 2]`` (largest objects first, restarting the whole
     layout when one does not fit); ``sample(rng)`` proposes one point."""
@@ -79,7 +79,7 @@ def layout(task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str], se
         landmarks[mark] = c
 
         def sample(r):
-            return np.array([r.uniform(0.33, 0.58), side * r.uniform(-0.38, 0.12)])
+            return np.array([r.uniform(0.28, 0.62), side * r.uniform(-0.45, 0.14)])
 
         xy = _place(rng, radii, sample, f"{task} table")
     elif mark == "spill":
