@@ -46,7 +46,6 @@ import abc
 import argparse
 import contextlib
 import errno
-import fcntl
 import hashlib
 import math
 import os
@@ -201,7 +200,8 @@ def check_picklable(executor: str, fn: Callable[[Any], Any]) -> None:
 class Executor(abc.ABC):
     """Runs ``fn`` over many items. Batch-first: one :meth:`map` call per sweep.
 
-    Executors are context managers; :meth:`close` releases their workers (idempotent).
+    Executors are context managers; :meth:`close` releases their workers (idempotent). Factories
+    registered under kind ``"executor"`` should accept ``max_workers=`` (``--workers`` passes it).
     """
 
     name: ClassVar[str]
@@ -441,7 +441,8 @@ class ConcurrencyLimit(abc.ABC):
 
 def default_lock_directory() -> str:
     """``$GIFT_LOCK_DIR``, else ``<tmp>/gift-locks-<uid>`` (one machine)."""
-    return os.environ.get("GIFT_LOCK_DIR") or os.path.join(tempfile.gettempdir(), f"gift-locks-{os.getuid()}")
+    user = os.getuid() if hasattr(os, "getuid") else os.environ.get("USERNAME", "user")
+    return os.environ.get("GIFT_LOCK_DIR") or os.path.join(tempfile.gettempdir(), f"gift-locks-{user}")
 
 
 class RateLimit(ConcurrencyLimit):
@@ -467,6 +468,8 @@ class RateLimit(ConcurrencyLimit):
         return os.path.join(self.directory, f"{digest}.{slot}.lock")
 
     def acquire(self, timeout: float | None = None) -> int:
+        import fcntl  # POSIX only; imported here so the core still imports elsewhere
+
         os.makedirs(self.directory, exist_ok=True)
         deadline = None if timeout is None else time.monotonic() + timeout
         first = os.getpid() % self.max_concurrent  # spread processes over slots (does not affect results)
@@ -488,6 +491,8 @@ class RateLimit(ConcurrencyLimit):
             delay = min(delay * 1.5, 20 * self.poll)
 
     def release(self, token: int) -> None:
+        import fcntl
+
         try:
             fcntl.flock(token, fcntl.LOCK_UN)
         finally:
