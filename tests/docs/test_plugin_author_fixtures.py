@@ -39,10 +39,11 @@ def test_the_language_kernel_meets_the_kernel_contract(kernel_contract, tiny_obj
     assert k.shape == (len(test), len(train))
 
 
-@pytest.mark.parametrize("name", ["maxent-linear", "maxent-neural"])
-def test_the_reward_models_meet_the_reward_contract(reward_contract, name):
+@pytest.mark.parametrize("name, options", [("maxent-linear", {}),
+                                           pytest.param("maxent-neural", {"max_epochs": 150}, marks=pytest.mark.slow)])
+def test_the_reward_models_meet_the_reward_contract(reward_contract, name, options):
     pytest.importorskip("gift_rewards")
-    scores = reward_contract(gift.get_reward_model(name))
+    scores = reward_contract(gift.get_reward_model(name, **options))
     assert np.all(np.isfinite(scores))
 
 
