@@ -299,7 +299,7 @@ def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: 
         reward = timed("train reward", lambda: gift.get_reward_model(cfg.reward).fit(demos, alts))
 
         # ---- intent
-        needs_intent = any(comp.kernel(k).uses_intent for k in cfg.kernels)
+        needs_intent = any(gift.get_manager().get("kernel", k).factory.uses_intent for k in cfg.kernels)
         if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
             def _infer():
                 main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
