@@ -9,9 +9,9 @@ its share the agreement rate (:meth:`MappingKernel.votes`).
 ``gift-prob`` (:class:`GiftProbKernel`): a continuous kernel from one yes/no question per object, "is
 this object something the goal is about?", built from the goal's own words and the object's
 description and read through ``choice_probabilities``. Its score is the log-odds
-``log P(yes) - log P(no)``; by default it is averaged, as z-scores, with MiniLM description similarity
-to the training objects that are relevant under the intent (see ``docs/results/gift_prob.md`` for the
-variants measured). Training objects are never shown to the LM as labelled examples, so they can
+``log P(yes) - log P(no)``; by default it is averaged, as z-scores, with a contrastive MiniLM description
+similarity: the largest cosine to a training object that is relevant under the intent minus the largest
+cosine to one that is not (see ``docs/results/gift_prob.md`` for the variants measured and why this won). Training objects are never shown to the LM as labelled examples, so they can
 calibrate the threshold by leave-one-out.
 
 Matrix rule of the relevance kernels (``gift-prob``): ``K[i, j] = r_i`` for the training objects j that
@@ -216,7 +216,7 @@ class GiftProbKernel(SimilarityKernel):
     uses_intent: ClassVar[bool] = True
 
     def __init__(self, lm: LMBackend | str | None = None, template: str = "goal", use_descriptions: bool = True,
-                 axes: bool = False, combine: str = "language", embed_reference: str = "relevant",
+                 axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
                  weight: float = 0.5, standardize: str = "pooled",
                  language_kernel: SimilarityKernel | None = None) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:

@@ -28,14 +28,16 @@ from gift.core.suite import Suite, load_suite
 
 #: name -> GiftProbKernel options. The first entry is the default of gift-prob.
 VARIANTS: dict[str, dict[str, Any]] = {
-    "lm+minilm": dict(template="goal", combine="language"),
+    "lm+minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive"),
     "lm": dict(template="goal", combine="none"),
+    "lm+minilm": dict(template="goal", combine="language", embed_reference="relevant"),
     "lm-about": dict(template="about", combine="none"),
     "lm-name": dict(template="goal-name", combine="none"),
-    "lm+minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive"),
-    "lm+minilm-trainstats": dict(template="goal", combine="language", standardize="train"),
+    "lm+minilm-trainstats": dict(template="goal", combine="language", embed_reference="relevant",
+                                 standardize="train"),
     "lm-about+minilm": dict(template="about", combine="language"),
-    "minilm": dict(template="goal", combine="language", weight=1.0),
+    "minilm": dict(template="goal", combine="language", embed_reference="relevant", weight=1.0),
+    "minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive", weight=1.0),
 }
 
 
