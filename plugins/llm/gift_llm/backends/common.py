@@ -6,7 +6,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from gift.core.data import Message, as_messages
+from gift.core.data import as_messages
 from gift.core.errors import LMError
 
 
@@ -56,7 +56,3 @@ def renormalise(mass: dict[str, float]) -> dict[str, float]:
     if not np.isfinite(total) or total <= 0.0:
         return {c: 1.0 / len(mass) for c in mass}
     return {c: m / total for c, m in mass.items()}
-
-
-def as_message_tuple(messages) -> tuple[Message, ...]:
-    return as_messages(messages)
