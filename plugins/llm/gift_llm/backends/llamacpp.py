@@ -14,6 +14,7 @@ instance on that file; calls to it are serialised by a lock.
 
 from __future__ import annotations
 
+import atexit
 import json
 import threading
 import time
@@ -57,6 +58,18 @@ def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int = 2, n_bat
         LOAD_COUNT += 1
         _MODELS[key] = (llama, threading.RLock())
         return _MODELS[key]
+
+
+@atexit.register
+def _close_all() -> None:
+    """Free the shared models before interpreter shutdown (avoids noise from ``Llama.__del__`` at exit)."""
+    with _MODELS_LOCK:
+        for llama, _ in _MODELS.values():
+            try:
+                llama.close()
+            except Exception:  # noqa: BLE001 - best effort at exit
+                pass
+        _MODELS.clear()
 
 
 class LlamaCppLM(LMBackend):
