@@ -1,7 +1,7 @@
 """LM plugin speed: prompt-prefix reuse in llama.cpp, and the SQLite cache, each against its naive baseline.
 
 - ``prefix``: yes/no ``choice_probabilities`` of the embedded model for questions that share a long system
-  prompt (~370 tokens) — KV-cache reuse of the shared prefix (``reuse_prefix=True``, the default) vs
+  prompt (237-token prompts, 224 tokens shared) — KV-cache reuse of the shared prefix (``reuse_prefix=True``, the default) vs
   re-evaluating the whole prompt every call (``reuse_prefix=False``).
 - ``cache``: the same questions answered from the persistent cache vs by the model.
 
