@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -92,3 +93,41 @@ def test_kernel_specs():
     assert parse_kernel_spec("gift:samples=3:temperature=0.7") == ("gift", {"samples": 3, "temperature": 0.7})
     with pytest.raises(gift.GiftError, match="key=value"):
         parse_kernel_spec("gift:samples")
+
+
+@pytest.mark.lm
+@pytest.mark.drake
+@pytest.mark.skipif(not os.environ.get("GIFT_RUN_INFERRED_EVAL"),
+                    reason="20+ min on a loaded 2-core machine (Calls 1-2 of the embedded LM); "
+                           "set GIFT_RUN_INFERRED_EVAL=1 to run")
+def test_inferred_intent_runs_the_gift_front_half_and_a_rerun_is_served_from_the_cache():
+    """Drake demonstrations -> lm-contrastive (Calls 1-2) on the embedded LM, for one intent.
+
+    The surface kernel ignores the intent, so its numbers must equal the ground-truth run's; the
+    one-kernel-call-per-scene bound is checked in test_alignment (the LM kernels' sample counts in
+    test_lm_kernels).
+    """
+    from gift_llm import get_default_lm
+
+    from gift_kernels.evaluation import _jsonable, evaluate_kernel, inferred_intent_source
+
+    suite = load_suite(SUITE)
+    lm = get_default_lm()
+    kernel = gift.get_kernel("language")
+
+    def run():
+        before = lm.stats.as_dict()
+        res = evaluate_kernel(kernel, suite, intents=["art_supplies"], intent_for=inferred_intent_source(n_pairs=1))
+        after = lm.stats.as_dict()
+        return res, {k: after[k] - before[k] for k in ("requests", "misses")}
+
+    res, used = run()
+    assert not res.errors, res.errors
+    (r,) = res.intents
+    assert r.intent_text.strip() and r.intent_text != "pack art supplies"  # inferred, not the label
+    assert 2 <= used["requests"] <= 2 * 3  # Calls 1 and 2, each with at most 2 repairs
+    truth = evaluate_kernel(kernel, suite, intents=["art_supplies"])
+    assert _jsonable(truth.intents[0].metrics) == _jsonable(r.metrics)  # NaN AUCs (one-class subsets) -> None
+    res2, used2 = run()
+    assert used2["misses"] == 0  # the rerun is served from the LM cache
+    assert res2.intents[0].intent_text == r.intent_text
