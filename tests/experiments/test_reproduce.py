@@ -7,7 +7,9 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 
+import gift
 from gift_experiments.report import write_report
 from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
 
@@ -16,12 +18,36 @@ pytestmark = [pytest.mark.slow, pytest.mark.lm, pytest.mark.drake]
 KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
 
 
+N_TEST = 8
+
+
+def mini_suite(path):
+    """The `valuables` intent of gift-paper with 8 of its test objects (4 relevant, 4 not, confounds first)."""
+    suite = gift.load_suite("gift-paper")
+    spec = suite.intent("valuables")
+    rel = [t for t in spec.test if t.relevant][: N_TEST // 2]
+    irr = sorted((t for t in spec.test if not t.relevant), key=lambda t: not t.confounds)[: N_TEST // 2]
+    names = list(spec.train_objects) + [t.object for t in rel + irr]
+    doc = {"suite": "mini-valuables",
+           "objects": {n: {"description": suite.objects[n].description,
+                           "appearance": {"shape": suite.objects[n].appearance.shape,
+                                          "size": list(suite.objects[n].appearance.size),
+                                          "color": list(suite.objects[n].appearance.color)}} for n in names},
+           "intents": [{"id": "valuables", "task": spec.task, "text": spec.text,
+                        "train_objects": list(spec.train_objects), "relevant_train": list(spec.relevant_train),
+                        "test": [{"object": t.object, "relevant": t.relevant, "confounds": list(t.confounds)}
+                                 for t in rel + irr]}]}
+    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    return path
+
+
 @pytest.fixture(scope="module")
 def reduced(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce")
-    cfg = ReproduceConfig(intents=("valuables",), kernels=KERNELS, seeds=2, pairs=60, samples=2, train_scenes=2,
+    suite = mini_suite(out / "mini-suite.yaml")
+    cfg = ReproduceConfig(suite=str(suite), kernels=KERNELS, seeds=2, pairs=60, samples=1, train_scenes=2,
                           demos_per_scene=4, alternatives_per_scene=12, trajectories_per_generator=6,
-                          sanity_reps=2, thresholds=("train-calibrated", "oracle"), rq3=True)
+                          sanity_reps=1, thresholds=("train-calibrated", "oracle"), rq3=True)
     results = run(cfg, out, Progress(False), log=lambda m: None)
     return cfg, out, results
 
@@ -37,10 +63,10 @@ def test_every_stage_produces_numbers_for_every_kernel(reduced):
     rq2 = results["rq2"]["valuables"]
     for k in KERNELS:
         m = rq2[k]["train-calibrated"]["all"]
-        assert m["n"] == 21 and m["tp"] + m["fp"] + m["tn"] + m["fn"] == 21
+        assert m["n"] == N_TEST and m["tp"] + m["fp"] + m["tn"] + m["fn"] == N_TEST
         assert rq2[k]["oracle"]["all"]["f1"] >= m["f1"] - 1e-9  # the oracle cut is an upper bound
     sanity = results["sanity"]["valuables"]
-    assert len(sanity["texts"]) == 2 and all(isinstance(t, str) and t for t in sanity["texts"])
+    assert len(sanity["texts"]) == 1 and all(isinstance(t, str) and t for t in sanity["texts"])
     assert -1.0 <= sanity["inferred"][0] <= 1.0
     intent = results["intents"]["valuables"]
     assert intent["source"] == "inferred" and intent["motivations"]
@@ -48,7 +74,7 @@ def test_every_stage_produces_numbers_for_every_kernel(reduced):
     for k, v in rq3.items():
         assert len(v["objects"]) == 4 and np.isclose(sum(v["mean"]), 1.0), k
     scatter = results["scatter"]["valuables"]["points"]
-    assert len(scatter) == 21 and all(0.0 <= p["language"] <= 1.0 and 0.0 <= p["vision"] <= 1.0 for p in scatter)
+    assert len(scatter) == N_TEST and all(0.0 <= p["language"] <= 1.0 and 0.0 <= p["vision"] <= 1.0 for p in scatter)
     assert results["manifest"]["lm"]["usage"]["misses"] > 0
 
 

@@ -63,6 +63,8 @@ def run_reproduce(args: argparse.Namespace) -> int:
 def _configure_demo(p: argparse.ArgumentParser) -> None:
     p.add_argument("--intent", default="art_supplies", help="intent id of the gift-paper suite")
     p.add_argument("--lm", default=None, help="LM to use (default: the embedded model)")
+    p.add_argument("--kernels", default="vision,language,gift-prob",
+                   help="comma-separated kernels (add gift,lm-no-intent for the binary Call-3 kernels: slow on CPU)")
     p.add_argument("--out", default="out/demo")
     p.add_argument("--quiet", action="store_true")
 
@@ -70,7 +72,8 @@ def _configure_demo(p: argparse.ArgumentParser) -> None:
 def run_demo(args: argparse.Namespace) -> int:
     from gift_experiments.demo import demo
 
-    return demo(intent=args.intent, lm=args.lm, out=Path(args.out), progress=not args.quiet)
+    kernels = tuple(k.strip() for k in args.kernels.split(",") if k.strip())
+    return demo(intent=args.intent, lm=args.lm, out=Path(args.out), progress=not args.quiet, kernels=kernels)
 
 
 @hookimpl

@@ -147,7 +147,9 @@ class Components:
         return self._kernels[name]
 
     def estimator(self, seed: int = 0, temperature: float = 0.0):
-        return gift.get_intent_estimator("lm-contrastive", lm=self.lm, seed=seed, temperature=temperature)
+        # Call 2 (semantic axes) only feeds the binary `gift` kernel's prompt; skip it when no kernel reads it
+        return gift.get_intent_estimator("lm-contrastive", lm=self.lm, seed=seed, temperature=temperature,
+                                         axes="gift" in self.cfg.kernels)
 
 
 # ----------------------------------------------------------------------------- data generation
