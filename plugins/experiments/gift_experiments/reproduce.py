@@ -425,7 +425,9 @@ def manifest(cfg: ReproduceConfig, comp: Components) -> dict:
         m["lm"] = {"identity": lm.identity()}
         stats = getattr(lm, "stats", None)
         if stats is not None:
-            m["lm"]["usage"] = attrs.asdict(stats) if attrs.has(type(stats)) else dict(vars(stats))
+            public = {k: v for k, v in (attrs.asdict(stats, recurse=False) if attrs.has(type(stats))
+                                        else vars(stats)).items() if not k.startswith("_")}
+            m["lm"]["usage"] = public
         try:
             from gift_llm.embedded import EXPECTED_SHA256
 
