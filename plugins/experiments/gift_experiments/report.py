@@ -229,7 +229,7 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     """Write ``out/report.md`` (tables + figures inline) and ``out/results.json``."""
     out.mkdir(parents=True, exist_ok=True)
     figures = make_figures(results, out)
-    (out / "results.json").write_text(json.dumps(results, indent=2, default=_json_default))
+    (out / "results.json").write_text(json.dumps(results, indent=2, default=json_default))
     lines = ["# gift reproduce report", ""]
     if command:
         lines += ["Made by:", "", f"```\n{command}\n```", ""]
@@ -264,7 +264,8 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     return path
 
 
-def _json_default(o: Any) -> Any:
+def json_default(o: Any) -> Any:
+    """``json.dumps(default=...)`` for numpy scalars and arrays."""
     if isinstance(o, np.generic):
         return o.item()
     if isinstance(o, np.ndarray):

@@ -32,6 +32,7 @@ from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatc
 from gift.core.errors import GiftError
 from gift.core.metrics import boltzmann, mean_se, pairwise_win_rate, sample_pairs
 from gift.core.suite import IntentSpec, Suite
+from gift_experiments.report import json_default
 
 GENERIC_INTENT = "The human prefers to move objects around the table."
 ALL_KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
@@ -93,17 +94,9 @@ class StageCache:
             return json.loads(path.read_text())
         value = fn()
         tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(value, default=_jsonable))
+        tmp.write_text(json.dumps(value, default=json_default))
         tmp.replace(path)
         return value
-
-
-def _jsonable(o: Any) -> Any:
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(type(o).__name__)
 
 
 def _seed(*parts: Any) -> int:
