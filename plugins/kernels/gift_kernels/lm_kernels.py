@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import threading
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -318,7 +319,8 @@ class GiftProbKernel(SimilarityKernel):
         sim = np.asarray(self.language.similarity(list(objs), list(train)), dtype=float)
         if exclude_self:
             np.fill_diagonal(sim, np.nan)
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows (no partner left) become 0 below
             pos = np.nanmax(np.where(rel[None, :], sim, np.nan), axis=1) if rel.any() else np.zeros(len(objs))
             out = pos
             if self.embed_reference == "contrastive" and (~rel).any():
