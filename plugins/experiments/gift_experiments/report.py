@@ -236,6 +236,10 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     cfg = results.get("config", {})
     if cfg:
         lines += ["Configuration: " + ", ".join(f"`{k}={v}`" for k, v in cfg.items()), ""]
+    if results.get("intents"):
+        lines += ["## Intents the kernels were conditioned on", "", "| intent | source | text |", "|---|---|---|"]
+        lines += [f"| {i} | {d.get('source', '')} | {d.get('text', '')} |" for i, d in results["intents"].items()]
+        lines.append("")
     if results.get("sanity"):
         lines += ["## Sanity check: inferred intents", "",
                   "| intent | LM-inferred (cosine to truth) | generic control |", "|---|---|---|"]
