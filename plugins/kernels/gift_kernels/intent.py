@@ -60,14 +60,7 @@ def parse_motivations(answer: Mapping[str, Any], features: Sequence[str]) -> tup
         raise ValidationError(f"the answer has no 'motivations' key (keys: {list(answer)})")
     mots, unknown = [], []
     for text, feats in _entries(answer["motivations"], "features"):
-        names = []
-        for f in feats:
-            name = known.get(_norm(f))
-            if name is None:
-                unknown.append(str(f))
-            elif name not in names:
-                names.append(name)
-        mots.append(Motivation(text=text, features=tuple(names)))
+        mots.append(Motivation(text=text, features=_canonical(feats, known, unknown)))
     if unknown:
         raise ValidationError(f"features {sorted(set(unknown))} do not exist; use only: {list(features)}")
     if not mots:
@@ -82,6 +75,18 @@ def parse_motivations(answer: Mapping[str, Any], features: Sequence[str]) -> tup
     return mots[:3], sims
 
 
+def _canonical(raw: Sequence[Any], known: Mapping[str, str], unknown: list[str]) -> tuple[str, ...]:
+    """The known names in ``raw`` (canonical spelling, first occurrence kept); the others go to ``unknown``."""
+    names: list[str] = []
+    for item in raw:
+        name = known.get(_norm(item))
+        if name is None:
+            unknown.append(str(item))
+        elif name not in names:
+            names.append(name)
+    return tuple(names)
+
+
 def parse_axes(answer: Mapping[str, Any], objects: Sequence[str]) -> list[SemanticAxis]:
     """Validate Call 2: axes (yes/no questions) over object names that exist; unknown names raise."""
     known = {_norm(o): o for o in objects}
@@ -89,14 +94,7 @@ def parse_axes(answer: Mapping[str, Any], objects: Sequence[str]) -> list[Semant
         raise ValidationError(f"the answer has no 'axes' key (keys: {list(answer)})")
     axes, unknown = [], []
     for q, objs in _entries(answer["axes"], "objects"):
-        names = []
-        for o in objs:
-            name = known.get(_norm(o))
-            if name is None:
-                unknown.append(str(o))
-            elif name not in names:
-                names.append(name)
-        axes.append(SemanticAxis(question=q, objects=tuple(names)))
+        axes.append(SemanticAxis(question=q, objects=_canonical(objs, known, unknown)))
     if unknown:
         raise ValidationError(f"objects {sorted(set(unknown))} do not exist; use only: {list(objects)}")
     return axes
