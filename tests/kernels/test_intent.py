@@ -125,3 +125,23 @@ def test_infer_intent_command_on_the_embedded_model(tmp_path, capsys):
     assert all(set(m["features"]) <= feats for m in intent["motivations"])
     assert all(set(a["objects"]) <= set(OBJECTS) for a in intent["axes"])
     assert main(["infer-intent", str(tmp_path / "nope.json")]) == 1
+
+
+def test_call1_prompt_shrinks_steps_then_features_to_fit_the_budget():
+    pairs = [pack_pair(), pack_pair(("banana", "coffee mug")), pack_pair(("paintbrush",))]
+    full = LMContrastiveIntentEstimator(lm=None, max_prompt_chars=10**6)
+    msgs, features = full.intent_prompt(pairs)
+    size = sum(len(m.content) for m in msgs)
+    assert "Timestep 56" in msgs[-1].content  # 8 steps of 61: every 8th
+
+    est = LMContrastiveIntentEstimator(lm=None, max_prompt_chars=int(size * 0.8))
+    small, small_features = est.intent_prompt(pairs)
+    assert sum(len(m.content) for m in small) <= size * 0.8
+    assert small_features == features  # every feature is still named, shown or not
+    assert "Timestep 56" not in small[-1].content and "Timestep 0" in small[-1].content
+
+    # an impossible budget stops at 4 steps and 2 features per pair instead of looping
+    tiny, _ = LMContrastiveIntentEstimator(lm=None, max_prompt_chars=10).intent_prompt(pairs)
+    text = tiny[-1].content
+    assert "Timestep 48" in text and "Timestep 56" not in text  # every 16th of 61 -> 0, 16, 32, 48
+    assert all(line.count(": ") <= 3 for line in text.splitlines() if line.startswith("Timestep"))

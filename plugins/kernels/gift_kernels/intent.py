@@ -9,7 +9,9 @@ object triggers a repair request naming it.
 
 To fit a 1.5B model with a 4k context, each trace shows only the features whose preferred and default
 values differ (at most ``max_features`` per pair, largest difference first), at about ``max_steps``
-evenly spaced time steps; every other feature is listed by name.
+evenly spaced time steps; every other feature is listed by name. When the prompt still exceeds
+``max_prompt_chars`` (about 2.5 characters per token for these traces), fewer time steps (down to 4)
+and then fewer features per pair (down to 2) are shown until it fits.
 """
 
 from __future__ import annotations
@@ -106,12 +108,14 @@ class LMContrastiveIntentEstimator(IntentEstimator):
     name: ClassVar[str] = "lm-contrastive"
 
     def __init__(self, lm: LMBackend | str | None = None, max_steps: int = 8, max_features: int = 6,
-                 temperature: float = 0.0, seed: int = 0, max_repairs: int = 2, axes: bool = True) -> None:
+                 temperature: float = 0.0, seed: int = 0, max_repairs: int = 2, axes: bool = True,
+                 max_prompt_chars: int = 8000) -> None:
         if max_steps < 2 or max_features < 1:
             raise GiftError(f"lm-contrastive: max_steps must be >= 2 and max_features >= 1, got {max_steps}, "
                             f"{max_features}")
         self._lm_spec, self._lm = lm, None
         self.max_steps, self.max_features = int(max_steps), int(max_features)
+        self.max_prompt_chars = int(max_prompt_chars)
         self.temperature, self.seed, self.max_repairs, self.with_axes = float(temperature), int(seed), \
             int(max_repairs), bool(axes)
         self.calls = 0
@@ -123,18 +127,19 @@ class LMContrastiveIntentEstimator(IntentEstimator):
         return self._lm
 
     # ------------------------------------------------------------------ prompt material
-    def shown_features(self, pair: DemonstrationPair) -> list[str]:
+    def shown_features(self, pair: DemonstrationPair, max_features: int | None = None) -> list[str]:
         """Features of ``pair`` whose preferred and default traces differ most (at most ``max_features``)."""
         diff = np.abs(pair.preferred.values - pair.default.values).max(axis=0)
-        order = [i for i in np.argsort(-diff, kind="stable") if diff[i] > 1e-3][: self.max_features]
+        order = [i for i in np.argsort(-diff, kind="stable") if diff[i] > 1e-3][: max_features or self.max_features]
         return [pair.preferred.specs[i].name for i in sorted(order)]
 
-    def pair_texts(self, demonstrations: Sequence[DemonstrationPair]) -> tuple[list[tuple[str, str]], dict, list]:
+    def pair_texts(self, demonstrations: Sequence[DemonstrationPair], max_steps: int | None = None,
+                   max_features: int | None = None) -> tuple[list[tuple[str, str]], dict, list]:
         """(default, preferred) texts per pair, descriptions of the shown features, the other features."""
         texts, desc, every_name = [], {}, {}
         for pair in demonstrations:
-            shown = self.shown_features(pair)
-            every = max(1, math.ceil(pair.preferred.values.shape[0] / self.max_steps))
+            shown = self.shown_features(pair, max_features)
+            every = max(1, math.ceil(pair.preferred.values.shape[0] / (max_steps or self.max_steps)))
             texts.append((pair.default.to_text(shown, every=every), pair.preferred.to_text(shown, every=every)))
             for s in pair.preferred.specs:
                 every_name.setdefault(s.name, s.description)
@@ -142,6 +147,20 @@ class LMContrastiveIntentEstimator(IntentEstimator):
                     desc[s.name] = s.description
         others = [n for n in every_name if n not in desc]
         return texts, desc, others
+
+    def intent_prompt(self, demonstrations: Sequence[DemonstrationPair], task_context: str = ""
+                      ) -> tuple[list, list[str]]:
+        """Call 1's messages, shrunk (steps, then features per pair) to ``max_prompt_chars``; and every feature."""
+        steps, feats = self.max_steps, self.max_features
+        while True:
+            texts, desc, others = self.pair_texts(demonstrations, steps, feats)
+            messages = prompts.intent_messages(texts, desc, others, task_context)
+            if sum(len(m.content) for m in messages) <= self.max_prompt_chars or (steps <= 4 and feats <= 2):
+                return messages, list(dict.fromkeys([*desc, *others]))
+            if steps > 4:
+                steps -= 1
+            else:
+                feats -= 1
 
     # ------------------------------------------------------------------ calls
     def motivations(self, demonstrations: Sequence[DemonstrationPair], task_context: str = ""
@@ -151,9 +170,7 @@ class LMContrastiveIntentEstimator(IntentEstimator):
 
         if not demonstrations:
             raise GiftError("lm-contrastive: no demonstration pairs given")
-        texts, desc, others = self.pair_texts(demonstrations)
-        features = list(dict.fromkeys([*desc, *others]))
-        messages = prompts.intent_messages(texts, desc, others, task_context)
+        messages, features = self.intent_prompt(demonstrations, task_context)
         self.calls += 1
         answer = ask_dict(self.lm, messages, validate=lambda d: parse_motivations(d, features) and None,
                           max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
