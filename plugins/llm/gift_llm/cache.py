@@ -1,32 +1,46 @@
-"""Persistent LM cache in SQLite, as a wrapper around any backend.
+"""Persistent LM cache (an SQLite file, or a Redis server), as a wrapper around any backend.
 
 Key: SHA-256 of the backend identity (name and model), the messages and every sampling parameter
 (temperature, seed, max_tokens, stop, json_schema) — seeded samples are distinct entries. Both
-:meth:`complete` and :meth:`choice_probabilities` are cached. The database lives at
-``$GIFT_CACHE_DIR/lm/lm-cache.sqlite`` (default root: the user cache directory), uses WAL journaling and a
-busy timeout so several processes can share it, and commits every entry at once so a killed run keeps
-what it computed. ``GIFT_LM_CACHE=off`` (or ``enabled=False``) bypasses it; statistics are still kept.
+:meth:`complete` and :meth:`choice_probabilities` are cached.
+
+Where entries live is decided by :func:`open_store`: by default the SQLite file
+``$GIFT_CACHE_DIR/lm/lm-cache.sqlite`` (default root: the user cache directory), which uses WAL journaling
+and a busy timeout so several processes can share it, and commits every entry at once so a killed run
+keeps what it computed; with ``GIFT_LM_CACHE_URL=redis://host:port/db`` (or ``url=``) a Redis server
+(:class:`gift_llm.redis_store.RedisStore`). ``GIFT_LM_CACHE=off`` (or ``enabled=False``) bypasses the
+cache; statistics are still kept.
+
+Single-flight: when several threads or processes miss the same key at once, one calls the model and the
+others wait for its answer (a per-key ``flock`` next to the SQLite file, a ``SET NX PX`` lock in Redis).
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import hashlib
 import json
 import os
 import sqlite3
 import threading
 import time
-from collections.abc import Mapping, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import attrs
 
 from gift.core.data import Completion, Message, Usage
 from gift.core.errors import LMError
 from gift.core.interfaces import LMBackend
-from gift_llm.paths import lm_cache_path
+from gift_llm.paths import lm_cache_path, lm_cache_url
 from gift_llm.requests import choices_request, complete_request, request_key
 from gift_llm.usage import MeteredLM
+
+if TYPE_CHECKING:
+    from gift_llm.redis_store import RedisStore
 
 _OFF = {"0", "off", "false", "no", "disabled"}
 _SCHEMA = """
@@ -45,12 +59,47 @@ def cache_enabled_by_env() -> bool:
     return os.environ.get("GIFT_LM_CACHE", "on").strip().lower() not in _OFF
 
 
-class CacheStore:
-    """The SQLite file: one connection per thread and process, safe to share between processes."""
+def store_spec(path: str | Path | None = None, url: str | None = None) -> tuple[str, str]:
+    """Which store :func:`open_store` opens: ``("redis", url)`` or ``("sqlite", path)``.
 
-    def __init__(self, path: str | Path | None = None, timeout_s: float = 60.0):
+    Order: ``url``, then ``path``, then ``$GIFT_LM_CACHE_URL``, then the default SQLite file.
+    """
+    if url:
+        return "redis", str(url)
+    if path:
+        return "sqlite", str(Path(path).expanduser())
+    env_url = lm_cache_url()
+    return ("redis", env_url) if env_url else ("sqlite", str(lm_cache_path()))
+
+
+def open_store(path: str | Path | None = None, url: str | None = None) -> SQLiteStore | RedisStore:
+    """The LM cache store: Redis when a URL is given or configured (:func:`store_spec`), else SQLite."""
+    kind, where = store_spec(path, url)
+    if kind == "redis":
+        from gift_llm.redis_store import RedisStore
+
+        return RedisStore(where)
+    return SQLiteStore(where)
+
+
+class SQLiteStore:
+    """The SQLite file: one connection per thread and process, safe to share between processes.
+
+    Single-flight locks are files ``<key>.lock`` locked with ``flock`` in ``lock_dir`` (default: the
+    directory ``<file>.locks`` next to the database, or a subdirectory of ``$GIFT_LOCK_DIR`` when set);
+    the kernel frees the lock of a process that dies. A waiter that did not get the lock within
+    ``lock_timeout_s`` calls the model itself.
+    """
+
+    kind = "sqlite"
+
+    def __init__(self, path: str | Path | None = None, timeout_s: float = 60.0, *,
+                 lock_dir: str | Path | None = None, lock_timeout_s: float = 600.0):
         self.path = Path(path).expanduser() if path else lm_cache_path()
+        self.location = str(self.path)
         self.timeout_s = timeout_s
+        self.lock_timeout_s = float(lock_timeout_s)
+        self.lock_dir = Path(lock_dir) if lock_dir else _default_lock_dir(self.path)
         self._local = threading.local()
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -92,8 +141,8 @@ class CacheStore:
     def summary(self) -> dict[str, Any]:
         rows = self._conn().execute("SELECT identity, kind, COUNT(*) FROM entries GROUP BY identity, kind").fetchall()
         size = self.path.stat().st_size if self.path.exists() else 0
-        return {"path": str(self.path), "entries": sum(r[2] for r in rows), "bytes": size,
-                "by_model": [{"identity": r[0], "kind": r[1], "entries": r[2]} for r in rows]}
+        return {"path": str(self.path), "store": self.kind, "entries": sum(r[2] for r in rows), "bytes": size,
+                "by_model": [{"identity": r[0], "kind": r[1], "entries": r[2]} for r in sorted(rows)]}
 
     def clear(self, identity: str | None = None) -> int:
         conn = self._conn()
@@ -101,19 +150,115 @@ class CacheStore:
                else conn.execute("DELETE FROM entries"))
         return cur.rowcount
 
+    @contextlib.contextmanager
+    def lock(self, key: str) -> Iterator[bool]:
+        """Single-flight for ``key``: an exclusive ``flock``; yields False if not taken in time."""
+        name = key if key.isalnum() and len(key) <= 128 else hashlib.sha256(key.encode()).hexdigest()
+        path = self.lock_dir / f"{name}.lock"
+        fd = _flock(path, self.lock_timeout_s)
+        if fd is None:
+            warnings.warn(f"LM cache: waited {self.lock_timeout_s:g} s for another process to answer {key[:16]}… "
+                          f"(lock file {path}); calling the model without the lock", RuntimeWarning, stacklevel=3)
+        try:
+            yield fd is not None
+        finally:
+            if fd is not None:
+                _unflock(path, fd)
+
+    def __repr__(self) -> str:
+        return f"SQLiteStore({self.location!r})"
+
+
+CacheStore = SQLiteStore  # the name before the Redis store existed
+
+
+def _default_lock_dir(db: Path) -> Path:
+    env = os.environ.get("GIFT_LOCK_DIR", "").strip()
+    if env:  # one subdirectory per cache file: unrelated caches never wait for each other
+        return Path(env) / f"lm-cache-{hashlib.sha1(str(db.resolve()).encode()).hexdigest()[:12]}"
+    return db.with_name(db.name + ".locks")
+
+
+def _flock(path: Path, timeout_s: float) -> int | None:
+    """Open and ``flock`` ``path``; the file descriptor, or None after ``timeout_s``.
+
+    The holder deletes the file on release, so a lock counts only if ``path`` still names the locked file.
+    """
+    import fcntl
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise LMError(f"LM cache: cannot create the lock directory {path.parent}: {e}") from e
+    deadline, delay = time.monotonic() + timeout_s, 0.002
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as e:
+            raise LMError(f"LM cache: cannot open the lock file {path}: {e}") from e
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as e:
+            os.close(fd)
+            if e.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise LMError(f"LM cache: cannot lock {path}: {e}") from e
+            if time.monotonic() >= deadline:
+                return None
+            time.sleep(delay)
+            delay = min(delay * 1.5, 0.05)
+            continue
+        try:
+            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)  # the previous holder deleted it after we opened it: try the current file
+
+
+def _unflock(path: Path, fd: int) -> None:
+    import fcntl
+
+    try:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(path)
+        fcntl.flock(fd, fcntl.LOCK_UN)
+    finally:
+        os.close(fd)
+
 
 class CachedLM(MeteredLM):
     """An :class:`LMBackend` that answers repeated requests from the persistent cache.
 
-    ``.stats`` (:class:`gift_llm.usage.UsageStats`) counts hits, misses, model calls, tokens, latency, cost.
+    ``path`` (SQLite file) or ``url`` (``redis://host:port/db``) choose the store (:func:`open_store`).
+    A miss takes the store's per-key lock and checks again before calling the model, so concurrent
+    identical requests make one model call. ``.stats`` (:class:`gift_llm.usage.UsageStats`) counts hits
+    (answers read from the store, also after waiting for another worker), misses, model calls, tokens,
+    latency, cost.
     """
 
     name = "cached"
 
-    def __init__(self, inner: LMBackend, path: str | Path | None = None, enabled: bool = True):
+    def __init__(self, inner: LMBackend, path: str | Path | None = None, enabled: bool = True, *,
+                 url: str | None = None):
         super().__init__(inner)
         self.enabled = bool(enabled) and cache_enabled_by_env()
-        self.store = CacheStore(path) if self.enabled else None
+        self.store = open_store(path, url) if self.enabled else None
+
+    def _lookup(self, key: str, kind: str, identity: str, request: Mapping[str, Any], call: Callable[[], Any],
+                encode: Callable[[Any], Any]) -> tuple[Any, Any]:
+        """``(stored JSON, None)`` on a hit, ``(None, fresh answer)`` after this worker's model call."""
+        hit = self.store.get(key)
+        if hit is None:
+            with self.store.lock(key):
+                hit = self.store.get(key)  # another worker may have answered while this one waited
+                if hit is None:
+                    self.stats.add_request(hit=False)
+                    out = call()
+                    self.store.put(key, kind, identity, request, encode(out))
+                    return None, out
+        self.stats.add_request(hit=True)
+        return hit, None
 
     def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
                  max_tokens: int = 512, stop: Sequence[str] | None = None,
@@ -125,15 +270,12 @@ class CachedLM(MeteredLM):
         req = complete_request(messages, **kw)
         key = request_key(identity, req)
         t0 = time.perf_counter()
-        hit = self.store.get(key)
-        if hit is not None:
-            self.stats.add_request(hit=True)
-            c = completion_from_json(hit, cached=True)
-            return attrs.evolve(c, usage=attrs.evolve(c.usage, latency_s=time.perf_counter() - t0, cost_usd=0.0))
-        self.stats.add_request(hit=False)
-        out = self._call_complete(messages, **kw)
-        self.store.put(key, "complete", identity, req, completion_to_json(out))
-        return out
+        hit, out = self._lookup(key, "complete", identity, req, lambda: self._call_complete(messages, **kw),
+                                completion_to_json)
+        if hit is None:
+            return out
+        c = completion_from_json(hit, cached=True)
+        return attrs.evolve(c, usage=attrs.evolve(c.usage, latency_s=time.perf_counter() - t0, cost_usd=0.0))
 
     def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
         if self.store is None:
@@ -141,14 +283,8 @@ class CachedLM(MeteredLM):
         identity = self.identity()
         req = choices_request(messages, choices)
         key = request_key(identity, req)
-        hit = self.store.get(key)
-        if hit is not None:
-            self.stats.add_request(hit=True)
-            return {c: float(hit[c]) for c in choices}
-        self.stats.add_request(hit=False)
-        out = self._call_choices(messages, choices)
-        self.store.put(key, "choices", identity, req, out)
-        return out
+        hit, out = self._lookup(key, "choices", identity, req, lambda: self._call_choices(messages, choices), dict)
+        return out if hit is None else {c: float(hit[c]) for c in choices}
 
 
 def completion_to_json(c: Completion) -> dict[str, Any]:

