@@ -1,8 +1,9 @@
 """Fixtures and set-up shared by the whole test suite (plugin authors: see ``gift.testing``).
 
-Every test session gets a fresh, empty gift cache directory (``GIFT_CACHE_DIR``), so no test is served by
-answers, embeddings or renders that an earlier run left behind; only the assembled embedded model
-(``models/``) is linked in from the user's cache instead of being copied again.
+Every test session gets a fresh, empty gift cache directory (``GIFT_CACHE_DIR``) and no Redis LM cache
+(``GIFT_LM_CACHE_URL`` is removed), so no test is served by answers, embeddings or renders that an earlier
+run left behind; only the assembled embedded model (``models/``) is linked in from the user's cache
+instead of being copied again.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ def pytest_configure(config):
     if models.is_dir():
         (_SESSION_CACHE / "models").symlink_to(models, target_is_directory=True)
     os.environ["GIFT_CACHE_DIR"] = str(_SESSION_CACHE)
+    os.environ.pop("GIFT_LM_CACHE_URL", None)  # nor by a Redis LM cache configured for real runs
 
 
 def pytest_unconfigure(config):

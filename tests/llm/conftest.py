@@ -84,3 +84,12 @@ def llama_server(embedded_gguf, tmp_path_factory):
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+
+
+@pytest.fixture
+def redis_url(tmp_path):
+    """A private ``redis-server`` on 127.0.0.1:<free port> (no persistence), stopped after the test; its URL."""
+    from redis_server import running_redis
+
+    with running_redis(tmp_path) as (url, _):
+        yield url
