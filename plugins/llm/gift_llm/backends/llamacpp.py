@@ -10,12 +10,18 @@
 
 One :class:`llama_cpp.Llama` is loaded per (model path, n_ctx) per process and shared by every backend
 instance on that file; calls to it are serialised by a lock.
+
+Threads: unless ``n_threads`` is given, a model uses the process's thread budget
+(:func:`default_threads`: ``$OMP_NUM_THREADS``, which the ``local`` executor sets for each worker and Ray
+sets for its tasks, else all cores), for generation and prompt evaluation alike, so the workers of a pool
+do not oversubscribe the cores.
 """
 
 from __future__ import annotations
 
 import atexit
 import json
+import os
 import threading
 import time
 from collections.abc import Mapping, Sequence
@@ -35,9 +41,24 @@ _MODELS_LOCK = threading.Lock()
 LOAD_COUNT = 0
 
 
-def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int = 2, n_batch: int = 512,
+def default_threads() -> int:
+    """CPU threads for a model of this process: ``$OMP_NUM_THREADS`` when it is a positive integer (the
+    ``local`` executor sets it to ``cpu_count // workers`` in each worker, Ray to a task's CPUs), else
+    ``os.cpu_count()``."""
+    try:
+        budget = int(os.environ.get("OMP_NUM_THREADS", "").strip())
+    except ValueError:
+        budget = 0
+    return budget if budget > 0 else (os.cpu_count() or 1)
+
+
+def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int | None = None, n_batch: int = 512,
                seed: int = 0, verbose: bool = False) -> tuple[Any, threading.RLock]:
-    """The shared ``Llama`` for ``path`` (loaded on first use) and the lock guarding it."""
+    """The shared ``Llama`` for ``path`` (loaded on first use) and the lock guarding it.
+
+    ``n_threads`` (generation and prompt evaluation; default :func:`default_threads`) only applies to the
+    first load of a (path, n_ctx) in a process.
+    """
     global LOAD_COUNT
     path = Path(path).expanduser().resolve()
     if not path.is_file():
@@ -50,9 +71,12 @@ def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int = 2, n_bat
             from llama_cpp import Llama
         except ImportError as e:
             raise LMError("llamacpp: llama-cpp-python is not installed (bash scripts/setup.sh installs it)") from e
+        threads = int(n_threads) if n_threads is not None else default_threads()
+        if threads < 1:
+            raise LMError(f"llamacpp: n_threads must be >= 1, got {n_threads!r}")
         try:
-            llama = Llama(model_path=str(path), n_ctx=int(n_ctx), n_threads=int(n_threads), n_batch=int(n_batch),
-                          seed=int(seed), logits_all=False, verbose=verbose)
+            llama = Llama(model_path=str(path), n_ctx=int(n_ctx), n_threads=threads, n_threads_batch=threads,
+                          n_batch=int(n_batch), seed=int(seed), logits_all=False, verbose=verbose)
         except Exception as e:  # noqa: BLE001 - llama.cpp raises ValueError/RuntimeError on bad files
             raise LMError(f"llamacpp: cannot load {path}: {type(e).__name__}: {e}") from e
         LOAD_COUNT += 1
@@ -73,12 +97,15 @@ def _close_all() -> None:
 
 
 class LlamaCppLM(LMBackend):
-    """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities)."""
+    """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities).
+
+    ``n_threads``: CPU threads (default: the process's budget, :func:`default_threads`).
+    """
 
     name: ClassVar[str] = "llamacpp"
     supports_choice_probabilities: ClassVar[bool] = True
 
-    def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int = 2,
+    def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int | None = None,
                  n_batch: int = 512, seed: int = 0, reuse_prefix: bool = True, verbose: bool = False,
                  **_ignored: Any):
         if model is None:
