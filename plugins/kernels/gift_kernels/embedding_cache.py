@@ -4,16 +4,45 @@ The disk cache lives under ``$GIFT_CACHE_DIR`` (default: the platform's user cac
 in ``embeddings/<model>/<sha1 of key>.npy``. Keys are texts (language) or object descriptions of what
 was rendered (vision); the model name and version are part of the directory, so a new model never
 reads another model's vectors.
+
+Reproducible vectors: the float32 output of a torch model changes in its last bits with the number of
+intra-op threads and, for padded text batches, with the other texts of the batch. The kernels therefore
+compute every missing vector on its own, on :data:`EMBED_THREADS` thread (:func:`torch_threads`), so a
+vector does not depend on which process computed it (the calling process, a pool or Ray worker with a
+different thread budget) or on what else was missing from the cache at the time.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
+
+#: torch intra-op threads while an embedding model computes vectors (fixed, so the bits are too).
+EMBED_THREADS = 1
+_threads_lock = threading.RLock()
+
+
+@contextlib.contextmanager
+def torch_threads(n: int = EMBED_THREADS) -> Iterator[None]:
+    """Run the block with torch on exactly ``n`` intra-op CPU threads; the previous count is restored.
+
+    Process-wide (torch has one setting); concurrent blocks in threads of one process are serialised.
+    """
+    import torch
+
+    with _threads_lock:
+        previous = torch.get_num_threads()
+        torch.set_num_threads(int(n))
+        try:
+            yield
+        finally:
+            torch.set_num_threads(previous)
 
 
 def gift_cache_dir() -> Path:

@@ -16,7 +16,7 @@ from gift.core.data import Intent, ObjectSpec
 from gift.core.errors import GiftError
 from gift.core.interfaces import SimilarityKernel
 from gift.core.metrics import cosine
-from gift_kernels.embedding_cache import EmbeddingCache
+from gift_kernels.embedding_cache import EmbeddingCache, torch_threads
 
 MODEL_ID = "all-MiniLM-L6-v2"
 _lock = threading.Lock()
@@ -43,10 +43,16 @@ _cache = EmbeddingCache(MODEL_ID)
 
 
 def embed_texts(texts: Sequence[str]) -> np.ndarray:
-    """Unit-norm MiniLM embeddings ``[n, 384]`` (cached per text in memory and on disk)."""
+    """Unit-norm MiniLM embeddings ``[n, 384]`` (cached per text in memory and on disk).
+
+    A missing text is encoded on its own (no padding from other texts) on a fixed number of threads, so
+    its vector is the same bits whichever process computes it (see :mod:`gift_kernels.embedding_cache`).
+    """
     def compute(missing: list[str]) -> np.ndarray:
-        return load_minilm().encode(missing, batch_size=64, normalize_embeddings=True, convert_to_numpy=True,
-                                    show_progress_bar=False)
+        model = load_minilm()
+        with torch_threads():
+            return np.stack([model.encode([t], normalize_embeddings=True, convert_to_numpy=True,
+                                          show_progress_bar=False)[0] for t in missing])
 
     return _cache.embed(list(texts), compute)
 

@@ -20,7 +20,7 @@ from gift.core.data import Intent, ObjectSpec
 from gift.core.errors import GiftError
 from gift.core.interfaces import SimilarityKernel
 from gift.core.metrics import cosine
-from gift_kernels.embedding_cache import EmbeddingCache
+from gift_kernels.embedding_cache import EmbeddingCache, torch_threads
 from gift_kernels.language import cosine_to_unit
 
 MODEL_ID = "efficientnet-lite0"
@@ -133,15 +133,20 @@ class VisionKernel(SimilarityKernel):
         """View-averaged features ``[n, 1280]``, cached by the content of the rendered images.
 
         Keying on the pixels (not the name) means a changed renderer never serves stale features, and
-        objects that look the same share one entry.
+        objects that look the same share one entry. Missing features are computed per object on a fixed
+        number of torch threads (:func:`gift_kernels.embedding_cache.torch_threads`).
         """
         keys, views = [], {}
         for o in objects:
             v = self.render(o)
             keys.append(hashlib.sha1(v.tobytes() + str(v.shape).encode()).hexdigest())
             views[keys[-1]] = v
-        return self._cache.embed(keys, lambda missing: np.stack([image_features(views[k]).mean(axis=0)
-                                                                 for k in missing]))
+
+        def compute(missing: list[str]) -> np.ndarray:  # fixed threads: same bits in every process
+            with torch_threads():
+                return np.stack([image_features(views[k]).mean(axis=0) for k in missing])
+
+        return self._cache.embed(keys, compute)
 
     def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                    intent: Intent | None = None) -> np.ndarray:
