@@ -37,7 +37,8 @@ by the kernel). :meth:`Executor.rate_limit` returns the right limiter for an exe
 returns a cluster-wide one); :class:`RateLimitedLM` wraps any :class:`~gift.core.interfaces.LMBackend`.
 
 CLI commands that run sweeps call :func:`add_executor_argument` on their parser and
-:func:`executor_from_args` in ``run``.
+:func:`executor_from_args` in ``run``; Python functions that take an ``executor=`` argument (an instance,
+a registered name, or None) resolve it with :func:`using_executor`.
 """
 
 from __future__ import annotations
@@ -205,6 +206,8 @@ class Executor(abc.ABC):
     """
 
     name: ClassVar[str]
+    #: True when ``fn`` runs in the calling process (callers may then pass it unpicklable callbacks).
+    in_process: ClassVar[bool] = False
 
     @property
     @abc.abstractmethod
@@ -238,6 +241,7 @@ class SerialExecutor(Executor):
     """Runs every item in the calling process, one after the other (the reference executor)."""
 
     name: ClassVar[str] = "serial"
+    in_process: ClassVar[bool] = True
 
     def __init__(self, max_workers: int | None = None) -> None:
         if max_workers not in (None, 1):
@@ -367,6 +371,23 @@ def get_executor(name_or_instance: str | Executor | None = None, **options: Any)
     if not isinstance(executor, Executor):
         raise ExecutorError(f"executor {name!r} built a {type(executor).__name__}, not a gift Executor")
     return executor
+
+
+@contextlib.contextmanager
+def using_executor(executor: str | Executor | None, default: str = "serial") -> Iterator[Executor]:
+    """``with using_executor(executor) as ex:`` for functions with an ``executor=`` argument.
+
+    An :class:`Executor` instance is used as is and left open (its owner closes it); a registered name,
+    or ``None`` for ``default``, is built here and closed when the block ends.
+    """
+    if isinstance(executor, Executor):
+        yield executor
+        return
+    built = get_executor(executor or default)
+    try:
+        yield built
+    finally:
+        built.close()
 
 
 # ------------------------------------------------------------------ CLI helpers
@@ -545,5 +566,5 @@ __all__ = [
     "DEFAULT_EXECUTOR", "ConcurrencyLimit", "ExecutionError", "Executor", "ExecutorError", "ItemFailure",
     "LocalExecutor", "RateLimit", "RateLimitedLM", "SerialExecutor", "add_executor_argument", "assemble",
     "check_picklable", "chunk_bounds", "default_lock_directory", "executor_from_args", "get_executor",
-    "item_seeds", "limited", "run_chunk",
+    "item_seeds", "limited", "run_chunk", "using_executor",
 ]
