@@ -13,6 +13,7 @@ from pathlib import Path
 
 from gift.core.data import DISTRACTOR, Intent, ObjectSpec
 from gift.core.errors import GiftError
+from gift.core.executor import add_executor_argument, executor_from_args
 from gift_kernels.alignment import THRESHOLDS, score_alignment
 
 # ----------------------------------------------------------------------------- gift align
@@ -123,6 +124,11 @@ def configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default=None, metavar="FILE", help="also write the full JSON result to FILE")
     p.add_argument("--detailed", action="store_true", help="also print every metric per subset")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    add_executor_argument(p)  # one item per (kernel, intent); serial checkpoints --out after every item
+
+
+def _progress(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
 
 
 def run_evaluate_alignment(args: argparse.Namespace) -> int:
@@ -133,15 +139,18 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
         raise GiftError("--kernels is empty")
     thresholds = [t.strip() for t in args.threshold.split(",") if t.strip()]
     intents = [i.strip() for i in args.intents.split(",")] if args.intents else None
-    progress = None if args.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))
-    def write(result: dict) -> None:  # after every kernel x intent: an interrupted run keeps its numbers
+    progress = None if args.quiet else _progress
+
+    def write(result: dict) -> None:  # serial: after every kernel x intent, so an interrupted run keeps its numbers
         tmp = Path(str(args.out) + ".tmp")
         tmp.write_text(json.dumps(result, indent=2), encoding="utf-8")
         tmp.replace(args.out)
 
-    result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
-                                lm=args.lm, intents=intents, progress=progress,
-                                checkpoint=write if args.out else None)
+    with executor_from_args(args) as executor:
+        result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
+                                    lm=args.lm, intents=intents, progress=progress,
+                                    checkpoint=write if args.out else None, executor=executor,
+                                    echo=progress is not None and not executor.in_process)
     print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
     failed = [k for k, d in result["kernels"].items() if d["errors"]]
     return 1 if len(failed) == len(kernels) else 0

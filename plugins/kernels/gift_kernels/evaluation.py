@@ -5,12 +5,18 @@ For every kernel, intent and threshold strategy: the kernel is run once per inte
 precision, recall, F1, AUC, FP and FN are computed on S_R, S_lang, S_vis, S_unk and their union
 (``all``), per intent and pooled over intents (``overall``). A kernel that fails is reported with its
 error; the others, and the intents that did finish, are kept.
+
+Each (kernel, intent) is an independent :class:`AlignmentItem` run by the module-level
+:func:`evaluate_item`, so the sweep runs on any executor of :mod:`gift.core.executor` (``serial``,
+``local``, ``ray``) with the same result; pooling over intents happens in the calling process.
 """
 
 from __future__ import annotations
 
+import functools
 import inspect
 import math
+import sys
 import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
@@ -21,6 +27,7 @@ import numpy as np
 
 from gift.core.data import DemonstrationPair, Intent
 from gift.core.errors import GiftError
+from gift.core.executor import Executor, using_executor
 from gift.core.metrics import binary_metrics, roc_auc
 from gift.core.suite import SUBSETS, IntentSpec, Suite, load_suite
 from gift_kernels.alignment import THRESHOLDS, AlignmentScores, score_alignment
@@ -160,12 +167,52 @@ def _create(kind: str, name: str, lm: str | None, **options: Any) -> Any:
 # ----------------------------------------------------------------------------- evaluation
 
 
+def score_intent(kernel: Any, suite: Suite, spec: IntentSpec, intent: Intent | None, thresholds: Sequence[str]
+                 ) -> tuple[AlignmentScores, dict[str, tuple[float, str]], dict[str, dict[str, dict[str, float]]]]:
+    """One kernel on one intent: its scores, the cut of every threshold, and metrics per threshold and subset."""
+    scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                             intent, relevant_train=spec.relevant_train, need=tuple(thresholds))
+    labels = {t.object: t.relevant for t in spec.test}
+    y = np.array([t.relevant for t in spec.test], dtype=bool)
+    cuts = {thr: scores.threshold(thr, labels) for thr in thresholds}
+    metrics = {thr: {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)], cuts[thr][0])
+                     for sub in REPORT_SUBSETS if _members(spec, sub).any()}
+               for thr in thresholds}
+    return scores, cuts, metrics
+
+
+@attrs.frozen
+class Failure:
+    """Why an intent failed: ``text`` for the result (``"Type: message"``, plus a short traceback when the
+    error is not a GiftError) and ``message`` (``"Type: message"``) for the progress line."""
+
+    text: str
+    message: str
+
+    @classmethod
+    def current(cls, e: BaseException) -> "Failure":
+        """The failure of ``e`` (call inside the ``except`` block, for the traceback)."""
+        message = f"{type(e).__name__}: {e}"
+        text = message if isinstance(e, GiftError) else message + "\n" + traceback.format_exc(limit=4)
+        return cls(text, message)
+
+
+def _done_line(name: str, intent_id: str, metrics: Mapping[str, Any], thresholds: Sequence[str],
+               seconds: float) -> str:
+    f1 = " ".join(f"{t}={metrics[t]['all']['f1']:.2f}" for t in thresholds)
+    return f"{name} / {intent_id}: F1 {f1} ({seconds:.1f}s)"
+
+
+def _failed_line(name: str, intent_id: str, message: str) -> str:
+    return f"{name} / {intent_id}: FAILED {message}"
+
+
 def evaluate_kernel(kernel: Any, suite: Suite, *, thresholds: Sequence[str] = THRESHOLDS,
                     intent_for: Callable[[IntentSpec, Suite], Intent] = lambda s, _: ground_truth_intent(s),
                     kernel_name: str | None = None, intents: Sequence[str] | None = None,
                     progress: Callable[[str], None] | None = None,
                     on_intent: Callable[[KernelResult], None] | None = None) -> KernelResult:
-    """Evaluate one kernel instance on every intent of ``suite`` (or the ids in ``intents``).
+    """Evaluate one kernel instance on every intent of ``suite`` (or the ids in ``intents``), in this process.
 
     ``on_intent(partial)`` gets the result so far after every intent (to checkpoint long LM runs).
     """
@@ -176,28 +223,18 @@ def evaluate_kernel(kernel: Any, suite: Suite, *, thresholds: Sequence[str] = TH
         t0 = time.perf_counter()
         try:
             intent = intent_for(spec, suite)
-            scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
-                                     intent, relevant_train=spec.relevant_train, need=tuple(thresholds))
-            labels = {t.object: t.relevant for t in spec.test}
-            y = np.array([t.relevant for t in spec.test], dtype=bool)
-            cuts = {thr: scores.threshold(thr, labels) for thr in thresholds}
-            metrics = {thr: {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)],
-                                                 cuts[thr][0])
-                             for sub in REPORT_SUBSETS if _members(spec, sub).any()}
-                       for thr in thresholds}
+            scores, cuts, metrics = score_intent(kernel, suite, spec, intent, thresholds)
         except Exception as e:  # noqa: BLE001 - one failing intent must not lose the others
-            errors[spec.id] = f"{type(e).__name__}: {e}"
+            failure = Failure.current(e)
+            errors[spec.id] = failure.text
             if progress:
-                progress(f"{name} / {spec.id}: FAILED {type(e).__name__}: {e}")
-            if not isinstance(e, GiftError):
-                errors[spec.id] += "\n" + traceback.format_exc(limit=4)
+                progress(_failed_line(name, spec.id, failure.message))
             if on_intent:
                 on_intent(KernelResult(name, tuple(results), dict(errors), pooled_metrics(suite, results, thresholds)))
             continue
         results.append(IntentResult(spec.id, scores, cuts, metrics, intent.text, time.perf_counter() - t0))
         if progress:
-            f1 = " ".join(f"{t}={metrics[t]['all']['f1']:.2f}" for t in thresholds)
-            progress(f"{name} / {spec.id}: F1 {f1} ({time.perf_counter() - t0:.1f}s)")
+            progress(_done_line(name, spec.id, metrics, thresholds, time.perf_counter() - t0))
         if on_intent:
             on_intent(KernelResult(name, tuple(results), dict(errors), pooled_metrics(suite, results, thresholds)))
     return KernelResult(name, tuple(results), errors, pooled_metrics(suite, results, thresholds))
@@ -228,15 +265,188 @@ def _value(v: str) -> Any:
     return v
 
 
+# ----------------------------------------------------------------------------- units of work (picklable)
+
+
+@attrs.frozen
+class IntentItem:
+    """Infer the intent of one suite intent (GIFT Calls 1-2 on simulated demonstrations)."""
+
+    suite: Suite
+    intent_id: str
+    lm: str | None = None
+
+
+@attrs.frozen
+class AlignmentItem:
+    """One kernel on one intent: the unit of work of ``evaluate-alignment``, run by :func:`evaluate_item`.
+
+    Carries its whole configuration, so any worker can run it. ``kernel``: spec (``name`` or
+    ``name:key=value``); ``intent``: the inferred intent, or None for the suite's ground-truth text.
+    """
+
+    suite: Suite
+    kernel: str
+    intent_id: str
+    thresholds: tuple[str, ...]
+    lm: str | None = None
+    intent: Intent | None = None
+
+
+@attrs.frozen
+class ItemOutcome:
+    """What :func:`evaluate_item` sends back: a result, an error of the intent, or an error building the kernel."""
+
+    kernel: str
+    intent_id: str
+    result: IntentResult | None = None
+    error: str | None = None
+    build_error: str | None = None
+    line: str = ""  # the progress line
+    seconds: float = 0.0
+
+
+#: Per worker process: built kernels by (spec, lm), inferrers by lm (reused by every item of a sweep).
+_WORKER_KERNELS: dict[tuple[str, str | None], Any] = {}
+_WORKER_INFERRERS: dict[str | None, Callable[[IntentSpec, Suite], Intent]] = {}
+
+
+def _echo(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def infer_item(item: IntentItem, *, infer: Callable[[IntentSpec, Suite], Intent] | None = None,
+               ) -> tuple[Intent | None, Failure | None]:
+    """``(intent, None)``, or ``(None, failure)`` when inference fails. ``infer``: default one
+    :func:`inferred_intent_source` per LM and worker process."""
+    if infer is None:
+        if item.lm not in _WORKER_INFERRERS:
+            _WORKER_INFERRERS[item.lm] = inferred_intent_source(lm=item.lm)
+        infer = _WORKER_INFERRERS[item.lm]
+    try:
+        return infer(item.suite.intent(item.intent_id), item.suite), None
+    except Exception as e:  # noqa: BLE001 - reported per kernel, like a failing kernel
+        return None, Failure.current(e)
+
+
+def evaluate_item(item: AlignmentItem, *, kernels: dict | None = None, echo: bool = False) -> ItemOutcome:
+    """Run one (kernel, intent) item; never raises for a failing kernel or intent (the outcome says why).
+
+    The kernel is built here (through the plugin manager; an LM kernel resolves ``item.lm`` with
+    gift_llm's ``resolve_lm``, i.e. the shared SQLite cache) and kept in ``kernels`` (default: a cache per
+    worker process). ``echo``: print the progress line to stderr (live progress from pool workers).
+    """
+    cache = _WORKER_KERNELS if kernels is None else kernels
+    t0 = time.perf_counter()
+    key = (item.kernel, item.lm)
+    try:
+        if key not in cache:
+            name, options = parse_kernel_spec(item.kernel)
+            cache[key] = _create("kernel", name, item.lm, **options)
+        kernel = cache[key]
+    except Exception as e:  # noqa: BLE001 - the kernel is reported as failed, the others go on
+        error = f"{type(e).__name__}: {e}"
+        out = ItemOutcome(item.kernel, item.intent_id, build_error=error, line=f"{item.kernel}: FAILED to build: {error}")
+    else:
+        spec = item.suite.intent(item.intent_id)
+        intent = item.intent if item.intent is not None else ground_truth_intent(spec)
+        try:
+            scores, cuts, metrics = score_intent(kernel, item.suite, spec, intent, item.thresholds)
+        except Exception as e:  # noqa: BLE001 - one failing intent must not lose the others
+            failure = Failure.current(e)
+            out = ItemOutcome(item.kernel, item.intent_id, error=failure.text, seconds=time.perf_counter() - t0,
+                              line=_failed_line(item.kernel, spec.id, failure.message))
+        else:
+            seconds = time.perf_counter() - t0
+            res = IntentResult(spec.id, scores, cuts, metrics, intent.text, seconds)
+            out = ItemOutcome(item.kernel, item.intent_id, result=res, seconds=seconds,
+                              line=_done_line(item.kernel, spec.id, metrics, item.thresholds, seconds))
+    if echo:
+        _echo(out.line)
+    return out
+
+
+class _Table:
+    """Collects outcomes into the result dict in kernel order, with progress lines and checkpoints."""
+
+    def __init__(self, out: dict[str, Any], suite: Suite, thresholds: Sequence[str],
+                 progress: Callable[[str], None] | None, checkpoint: Callable[[dict[str, Any]], None] | None,
+                 live: bool) -> None:
+        self.out, self.suite, self.thresholds = out, suite, list(thresholds)
+        self.progress, self.checkpoint, self.live = progress, checkpoint, live
+        self.results: list[IntentResult] = []
+        self.errors: dict[str, str] = {}
+
+    def _say(self, line: str, shown: bool = False) -> None:
+        if self.progress and not shown:
+            self.progress(line)
+
+    def _save(self) -> None:
+        if self.checkpoint and self.live:
+            self.checkpoint(self.out)
+
+    def _partial(self, kernel: str) -> KernelResult:
+        return KernelResult(kernel, tuple(self.results), dict(self.errors),
+                            pooled_metrics(self.suite, self.results, self.thresholds))
+
+    def build_failed(self, kernel: str, error: str, shown: bool = False) -> None:
+        self.out["kernels"][kernel] = {"kernel": kernel, "errors": {"*": error}, "overall": {}, "intents": {}}
+        self._say(f"{kernel}: FAILED to build: {error}", shown)
+        self._save()
+
+    def start(self) -> None:
+        self.results, self.errors = [], {}
+
+    def intent_failed(self, kernel: str, intent_id: str, error: str, line: str, shown: bool = False) -> None:
+        self.errors[intent_id] = error
+        self._say(line, shown)
+        self.out["kernels"][kernel] = self._partial(kernel).as_dict()
+        self._save()
+
+    def add(self, o: ItemOutcome, shown: bool = False) -> None:
+        if o.result is None:
+            self.intent_failed(o.kernel, o.intent_id, o.error or "no result", o.line, shown)
+            return
+        self.results.append(o.result)
+        self._say(o.line, shown)
+        self.out["kernels"][o.kernel] = self._partial(o.kernel).as_dict()
+        self._save()
+
+    def finish(self, kernel: str, seconds: float) -> None:
+        d = self._partial(kernel).as_dict()
+        d["seconds"] = round(seconds, 2)
+        self.out["kernels"][kernel] = d
+        self._save()
+
+
+def _kernel_spec_error(spec: str) -> str | None:
+    """Why a kernel spec cannot be built (bad syntax, unknown name), checked without building it."""
+    from gift.plugins.manager import get_manager
+
+    try:
+        name, _ = parse_kernel_spec(spec)
+        get_manager().get("kernel", name)
+    except Exception as e:  # noqa: BLE001 - reported like a failing kernel
+        return f"{type(e).__name__}: {e}"
+    return None
+
+
 def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds: Sequence[str] = THRESHOLDS,
                        intent_source: str = "ground-truth", lm: str | None = None,
                        intents: Sequence[str] | None = None,
                        progress: Callable[[str], None] | None = None,
-                       checkpoint: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+                       checkpoint: Callable[[dict[str, Any]], None] | None = None,
+                       executor: Executor | str | None = None, echo: bool = False) -> dict[str, Any]:
     """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
 
-    ``checkpoint(result_so_far)`` is called after every kernel x intent (e.g. to write a file), so an
-    interrupted run keeps what it computed.
+    The work is one :class:`AlignmentItem` per (kernel, intent), run by :func:`evaluate_item` on
+    ``executor`` (an :class:`~gift.core.executor.Executor`, a registered name, or None: ``serial``); with
+    ``intent_source="inferred"`` each intent is first inferred once (:class:`IntentItem`). The result is
+    the same on every executor. ``serial`` runs the items one after the other in this process, calling
+    ``progress(line)`` and ``checkpoint(result_so_far)`` after every kernel x intent (so an interrupted
+    run keeps what it computed). A pool runs every item in one ``map``; ``progress`` and ``checkpoint``
+    are then called when it returns, except that with ``echo=True`` the workers print each item's
+    progress line to stderr as soon as it is done (and ``progress`` does not repeat it).
     """
     if isinstance(suite, str):
         suite = load_suite(suite)
@@ -249,46 +459,88 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
         unknown = [i for i in intents if i not in {s.id for s in suite.intents}]
         if unknown:
             raise GiftError(f"suite {suite.name!r} has no intent(s) {unknown}")
-    if intent_source == "ground-truth":
-        intent_for = lambda s, _: ground_truth_intent(s)  # noqa: E731
-    else:
-        infer = inferred_intent_source(lm=lm)
-        cache: dict[str, Intent] = {}
-
-        def intent_for(spec: IntentSpec, s: Suite) -> Intent:  # one inference per intent, shared by kernels
-            if spec.id not in cache:
-                cache[spec.id] = infer(spec, s)
-            return cache[spec.id]
-
+    thresholds = tuple(thresholds)
+    specs = [s for s in suite.intents if intents is None or s.id in intents]
     out: dict[str, Any] = {"suite": suite.name, "suite_path": suite.path, "intent_source": intent_source,
                            "thresholds": list(thresholds), "lm": lm, "kernels": {}}
-    for spec in kernels:
-        t0 = time.perf_counter()
-        try:
-            name, options = parse_kernel_spec(spec)
-            kernel = _create("kernel", name, lm, **options)
-        except Exception as e:  # noqa: BLE001 - report and go on with the other kernels
-            out["kernels"][spec] = {"kernel": spec, "errors": {"*": f"{type(e).__name__}: {e}"}, "overall": {},
-                                    "intents": {}}
-            if progress:
-                progress(f"{spec}: FAILED to build: {type(e).__name__}: {e}")
-            if checkpoint:
-                checkpoint(out)
-            continue
-
-        def save(partial: KernelResult, spec: str = spec) -> None:
-            out["kernels"][spec] = partial.as_dict()
-            if checkpoint:
-                checkpoint(out)
-
-        res = evaluate_kernel(kernel, suite, thresholds=thresholds, intent_for=intent_for, kernel_name=spec,
-                              intents=intents, progress=progress, on_intent=save)
-        d = res.as_dict()
-        d["seconds"] = round(time.perf_counter() - t0, 2)
-        out["kernels"][spec] = d
-        if checkpoint:
-            checkpoint(out)
+    with using_executor(executor) as ex:
+        table = _Table(out, suite, thresholds, progress, checkpoint, live=ex.in_process)
+        if ex.in_process:
+            _run_in_process(ex, table, suite, kernels, specs, thresholds, intent_source, lm)
+        else:
+            _run_pool(ex, table, suite, kernels, specs, thresholds, intent_source, lm, echo)
     return out
+
+
+def _run_in_process(ex: Executor, table: _Table, suite: Suite, kernels: Sequence[str], specs: Sequence[IntentSpec],
+                    thresholds: tuple[str, ...], intent_source: str, lm: str | None) -> None:
+    """Kernel by kernel, intent by intent, one ``map`` per item: progress and checkpoints after each."""
+    built: dict = {}
+    infer = inferred_intent_source(lm=lm) if intent_source == "inferred" else None
+    inferred: dict[str, tuple[Intent | None, Failure | None]] = {}  # one inference per intent, shared by kernels
+    for kspec in kernels:
+        t0 = time.perf_counter()
+        error = _kernel_spec_error(kspec)
+        if error is not None:
+            table.build_failed(kspec, error)
+            continue
+        table.start()
+        failed_build = False
+        for spec in specs:
+            intent = None
+            if infer is not None:
+                if spec.id not in inferred:
+                    inferred[spec.id] = ex.map(functools.partial(infer_item, infer=infer),
+                                               [IntentItem(suite, spec.id, lm)])[0]
+                intent, failure = inferred[spec.id]
+                if failure is not None:
+                    table.intent_failed(kspec, spec.id, failure.text, _failed_line(kspec, spec.id, failure.message))
+                    continue
+            o = ex.map(functools.partial(evaluate_item, kernels=built),
+                       [AlignmentItem(suite, kspec, spec.id, thresholds, lm, intent)])[0]
+            if o.build_error is not None:
+                table.build_failed(kspec, o.build_error)
+                failed_build = True
+                break
+            table.add(o)
+        if not failed_build:
+            table.finish(kspec, time.perf_counter() - t0)
+
+
+def _run_pool(ex: Executor, table: _Table, suite: Suite, kernels: Sequence[str], specs: Sequence[IntentSpec],
+              thresholds: tuple[str, ...], intent_source: str, lm: str | None, echo: bool) -> None:
+    """Every item in one ``map`` (after one ``map`` of intent inferences); then the table, in kernel order."""
+    errors = {k: _kernel_spec_error(k) for k in kernels}
+    inferred: dict[str, tuple[Intent | None, Failure | None]] = {s.id: (None, None) for s in specs}
+    if intent_source == "inferred" and specs and any(e is None for e in errors.values()):
+        done = ex.map(infer_item, [IntentItem(suite, s.id, lm) for s in specs], chunksize=1)
+        inferred = dict(zip([s.id for s in specs], done))
+    items = [AlignmentItem(suite, k, s.id, thresholds, lm, inferred[s.id][0])
+             for k in dict.fromkeys(kernels) if errors[k] is None for s in specs if inferred[s.id][1] is None]
+    outcomes = ex.map(functools.partial(evaluate_item, echo=echo), items, chunksize=1) if items else []
+    by_item = {(o.kernel, o.intent_id): o for o in outcomes}
+    for kspec in kernels:
+        if errors[kspec] is not None:
+            table.build_failed(kspec, errors[kspec])
+            continue
+        table.start()
+        seconds, failed_build = 0.0, False
+        for spec in specs:
+            failure = inferred[spec.id][1]
+            if failure is not None:
+                table.intent_failed(kspec, spec.id, failure.text, _failed_line(kspec, spec.id, failure.message))
+                continue
+            o = by_item[(kspec, spec.id)]
+            if o.build_error is not None:
+                table.build_failed(kspec, o.build_error, shown=echo)
+                failed_build = True
+                break
+            table.add(o, shown=echo)
+            seconds += o.seconds
+        if not failed_build:
+            table.finish(kspec, seconds)
+    if table.checkpoint:
+        table.checkpoint(table.out)
 
 
 # ----------------------------------------------------------------------------- text report
