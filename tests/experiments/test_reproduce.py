@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 import gift
-from gift_experiments.report import write_report
+from gift_experiments.report import headline_table, write_report
 from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm, pytest.mark.drake]
@@ -103,3 +103,16 @@ def test_rerun_resumes_from_the_caches_without_model_calls(reduced):
     assert again["intents"] == results["intents"]
     usage = again["manifest"].get("lm", {}).get("usage", {"misses": 0})
     assert usage["misses"] == 0
+
+
+def test_headline_table_summarises_runs_per_robot(reduced):
+    cfg, out, results = reduced
+    table = headline_table({"jaco": results, "franka": results}, "train-calibrated")
+    lines = table.splitlines()
+    assert lines[0] == "| kernel | win rate (jaco) | F1 (jaco) | win rate (franka) | F1 (franka) |"
+    rows = {line.split(" | ")[0].strip("| "): line for line in lines[2:]}
+    assert set(rows) == set(KERNELS) | {ORACLE}
+    wr = results["rq1"]["valuables"]["gift-prob"]["mean"]
+    f1 = results["rq2"]["valuables"]["gift-prob"]["train-calibrated"]["all"]["f1"]
+    assert rows["gift-prob"].count(f"{wr:.3f}") == 2 and rows["gift-prob"].count(f"{f1:.3f}") == 2
+    assert rows[ORACLE].endswith("| – |")  # the label alignment has a win rate but no F1 row

@@ -225,6 +225,29 @@ def f1_table(results: dict, threshold: str, subset: str = "all") -> str:
     return "\n".join(rows)
 
 
+def headline_table(runs: dict[str, dict], threshold: str = "train-calibrated") -> str:
+    """Markdown: one row per kernel; per run (e.g. per robot) the RQ1 win rate (mean over intents ± SE
+    over intents) and the RQ2 alignment F1 on S_R ∪ S_conf (mean over intents) at ``threshold``."""
+    kernels: list[str] = []
+    for res in runs.values():
+        for k in _kernels(res.get("rq1") or {}) + _kernels(res.get("rq2") or {}):
+            if k not in kernels:
+                kernels.append(k)
+    kernels = [k for k in KERNEL_ORDER if k in kernels] + [k for k in kernels if k not in KERNEL_ORDER]
+    head = "| kernel | " + " | ".join(f"win rate ({r}) | F1 ({r})" for r in runs) + " |"
+    rows = [head, "|---" * (1 + 2 * len(runs)) + "|"]
+    for k in kernels:
+        cells = []
+        for res in runs.values():
+            wr = [per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per]
+            f1 = [per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
+                  if threshold in per.get(k, {}) and "all" in per[k][threshold]]
+            se = float(np.std(wr, ddof=1) / np.sqrt(len(wr))) if len(wr) > 1 else None
+            cells += [_fmt(float(np.mean(wr)), se) if wr else "–", _fmt(float(np.mean(f1))) if f1 else "–"]
+        rows.append(f"| {k} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
 def write_report(results: dict, out: Path, command: str = "") -> Path:
     """Write ``out/report.md`` (tables + figures inline) and ``out/results.json``."""
     out.mkdir(parents=True, exist_ok=True)
