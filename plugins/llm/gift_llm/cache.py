@@ -109,15 +109,30 @@ class SQLiteStore:
     def _conn(self) -> sqlite3.Connection:
         conn = getattr(self._local, "conn", None)
         if conn is None or getattr(self._local, "pid", None) != os.getpid():
+            conn = self._open()
+            self._local.conn, self._local.pid = conn, os.getpid()
+        return conn
+
+    def _open(self) -> sqlite3.Connection:
+        # Switching a new file to WAL can fail with "database is locked" without waiting for the busy
+        # timeout when several connections open it at the same moment: retry until ``timeout_s``.
+        deadline, delay = time.monotonic() + self.timeout_s, 0.005
+        while True:
+            conn = None
             try:
                 conn = sqlite3.connect(self.path, timeout=self.timeout_s, isolation_level=None)
                 conn.execute("PRAGMA journal_mode=WAL")
                 conn.execute("PRAGMA synchronous=NORMAL")
                 conn.execute(_SCHEMA)
+                return conn
             except sqlite3.Error as e:
-                raise LMError(f"LM cache: cannot open {self.path}: {e}") from e
-            self._local.conn, self._local.pid = conn, os.getpid()
-        return conn
+                if conn is not None:
+                    conn.close()
+                if not (isinstance(e, sqlite3.OperationalError) and "locked" in str(e)
+                        and time.monotonic() < deadline):
+                    raise LMError(f"LM cache: cannot open {self.path}: {e}") from e
+            time.sleep(delay)
+            delay = min(delay * 2, 0.1)
 
     def get(self, key: str) -> Any | None:
         try:
