@@ -14,6 +14,7 @@ import textwrap
 import threading
 import time
 import uuid
+import warnings
 from pathlib import Path
 
 import pytest
@@ -171,3 +172,26 @@ def test_sqlite_lock_files_live_next_to_the_cache_or_under_gift_lock_dir(tmp_pat
     monkeypatch.setenv("GIFT_LOCK_DIR", str(tmp_path / "locks"))
     other = open_store(path=tmp_path / "c.sqlite")
     assert other.lock_dir.parent == tmp_path / "locks" and other.lock_dir.name.startswith("lm-cache-")
+
+
+class FailingOnceLM(SlowLM):
+    """Test double: the first call raises, later calls answer (after ``delay_s``)."""
+
+    failed = False
+
+    def complete(self, messages, **kw):
+        if not self.failed:
+            self.failed = True
+            raise RuntimeError("provider error")
+        return super().complete(messages, **kw)
+
+
+def test_a_failed_model_call_releases_the_lock(store_args, tmp_path):
+    lm = CachedLM(FailingOnceLM(str(tmp_path), delay_s=0.0), **store_args)
+    lm.store.lock_timeout_s = 1.0
+    with pytest.raises(RuntimeError, match="provider error"):
+        lm.complete(QUESTION)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # waiting for a lock that was never released would warn
+        assert not lm.complete(QUESTION).usage.cached
+    assert lm.complete(QUESTION).usage.cached and len(list(tmp_path.glob("complete-*.call"))) == 1
