@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+from gift.core.executor import add_executor_argument, executor_from_args
 from gift.plugins.hookspecs import hookimpl
 
 
@@ -31,6 +32,7 @@ def _configure_reproduce(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-rq3", action="store_true")
     p.add_argument("--out", default="out/reproduce", help="output directory")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_executor_argument(p)  # one item per intent; the executor does not change the results
 
 
 def _config_from_args(args: argparse.Namespace):
@@ -45,6 +47,10 @@ def _config_from_args(args: argparse.Namespace):
                            rq3=not args.no_rq3)
 
 
+def _log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
 def run_reproduce(args: argparse.Namespace) -> int:
     from gift_experiments.report import write_report
     from gift_experiments.reproduce import Progress, run
@@ -52,7 +58,9 @@ def run_reproduce(args: argparse.Namespace) -> int:
     cfg = _config_from_args(args)
     out = Path(args.out)
     t0 = time.perf_counter()
-    results = run(cfg, out, Progress(enabled=not args.quiet), log=lambda m: print(m, file=sys.stderr))
+    with executor_from_args(args) as executor:  # pool workers print their intents' log lines themselves
+        results = run(cfg, out, Progress(enabled=not args.quiet), log=_log, executor=executor,
+                      echo=not executor.in_process)
     results["timing"]["total"] = time.perf_counter() - t0
     argv = sys.argv[sys.argv.index("reproduce"):] if "reproduce" in sys.argv else ["reproduce"]
     path = write_report(results, out, command="gift " + " ".join(shlex.quote(a) for a in argv))

@@ -10,16 +10,21 @@ cached by their own plugins):
 3. ``rq1``      win rate of R̃_θ(ξ'|ω) = R_θ(f_ω(ξ')) per kernel on test scenes of unseen objects.
 4. ``rq2``      alignment F1 / FP / FN per kernel, threshold and subset; the language-vs-vision scatter.
 5. ``rq3``      Boltzmann distribution over four candidates, each acting on a different held-out object.
+
+Every stage of one intent is one :class:`IntentJob` (:func:`run_intent`, seeds derived from the intent id),
+so :func:`run` runs the intents on any executor of :mod:`gift.core.executor` (``serial``, ``local``, ``ray``)
+and merges their slices of the results in intent order: the results do not depend on the executor.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import platform
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from importlib import metadata
 from pathlib import Path
 from typing import Any
@@ -30,6 +35,7 @@ import numpy as np
 import gift
 from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatch, Intent, Scene
 from gift.core.errors import GiftError
+from gift.core.executor import ExecutionError, Executor, using_executor
 from gift.core.metrics import boltzmann, mean_se, pairwise_win_rate, sample_pairs
 from gift.core.suite import IntentSpec, Suite
 from gift_experiments.report import json_default
@@ -152,17 +158,22 @@ def _features(sim, batch, task: str, specs) -> FeatureBatch:
     return sim.features(batch, task).reindex(specs)
 
 
-def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str):
-    """Preferred demonstrations and alternatives over the intent's training objects, plus demo pairs."""
+def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str,
+                  seeds: Sequence[int] | None = None):
+    """Preferred demonstrations and alternatives over the intent's training objects, plus demo pairs.
+
+    ``seeds``: one per training scene (default ``_seed("train", spec.id, k)``, see :func:`intent_seeds`).
+    """
     sim = comp.simulator(robot)
     task = gift.get_task(spec.task)
     specs = task.feature_specs(spec.train_objects)
     rel = list(spec.relevant_train)
     irr = [o for o in spec.train_objects if o not in rel]
+    if seeds is None:
+        seeds = [_seed("train", spec.id, k) for k in range(comp.cfg.train_scenes)]
     demos, alts, pairs = [], [], []
-    for k in range(comp.cfg.train_scenes):
+    for k, seed in enumerate(seeds):
         # each training scene holds a random subset of the training objects (several configurations)
-        seed = _seed("train", spec.id, k)
         names = _pick(rel, irr, comp.cfg.test_objects_per_scene, np.random.default_rng(seed))
         scene = sim.make_scene(spec.task, suite.specs(names), [n for n in names if n in rel], seed=seed)
         pref = _features(sim, sim.generate(scene, "preferred", comp.cfg.demos_per_scene, _seed("p", spec.id, k)),
@@ -271,16 +282,117 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
 # ----------------------------------------------------------------------------- the run
 
 
-def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: Callable[[str], None] = print) -> dict:
-    """Run every stage; return the results dictionary (see :mod:`gift_experiments.report`)."""
+def intent_seeds(cfg: ReproduceConfig, intent_id: str) -> dict[str, tuple[int, ...]]:
+    """The scene seeds of one intent, all derived from its id: ``train`` (one per training scene), ``rq1``
+    and ``rq3`` (one per seed of the test scenes). Trajectory seeds derive from these and the generator."""
+    return {"train": tuple(_seed("train", intent_id, k) for k in range(cfg.train_scenes)),
+            "rq1": tuple(_seed("rq1", intent_id, s) for s in range(cfg.seeds)),
+            "rq3": tuple(_seed("rq3", intent_id, s) for s in range(cfg.seeds))}
+
+
+@attrs.frozen(repr=False)
+class IntentJob:
+    """One intent of a run, the unit of work of :func:`run` (picklable; run by :func:`run_intent`).
+
+    ``suite``: the loaded suite (so workers need not resolve ``cfg.suite``); ``out``: absolute output
+    directory (stage caches in ``out/stages/<cfg.key()>/``); ``seeds``: :func:`intent_seeds`.
+    """
+
+    cfg: ReproduceConfig
+    suite: Suite
+    out: str
+    intent_id: str
+    seeds: Mapping[str, tuple[int, ...]]
+
+    def __repr__(self) -> str:
+        return f"IntentJob({self.intent_id!r}, config {self.cfg.key()}, out={self.out!r})"
+
+
+#: The per-intent slices of the results dictionary, merged in intent order.
+SECTIONS = ("sanity", "rq1", "rq2", "scatter", "rq3", "intents")
+#: Per worker process: the components of each config (simulators, kernels, LM), reused across intents.
+_WORKER_COMPONENTS: dict[ReproduceConfig, Components] = {}
+
+
+def _echo(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: Callable[[str], None] = print,
+        executor: Executor | str | None = None, echo: bool = False) -> dict:
+    """Run every stage; return the results dictionary (see :mod:`gift_experiments.report`).
+
+    One :class:`IntentJob` per intent runs on ``executor`` (an :class:`~gift.core.executor.Executor`, a
+    registered name, or None: ``serial``); the slices come back in intent order, so the results are the
+    same on every executor. ``serial`` runs the intents one after the other in this process with
+    ``progress`` bars and ``log`` lines as they happen. A pool runs them in one ``map``, each worker
+    building its own components; ``log`` then gets each intent's lines when the map returns, unless
+    ``echo=True``, which makes the workers print them to stderr as they happen. Executor options do not
+    change results and are not part of ``cfg``.
+    """
     progress = progress or Progress()
     suite = gift.load_suite(cfg.suite)
     intents = [suite.intent(i) for i in cfg.intents] if cfg.intents else list(suite.intents)
-    cache = StageCache(out, cfg.key())
-    comp = Components(cfg)
+    StageCache(out, cfg.key())
+    jobs = [IntentJob(cfg, suite, str(Path(out).resolve()), spec.id, intent_seeds(cfg, spec.id)) for spec in intents]
+    with using_executor(executor) as ex:
+        if ex.in_process:
+            fn = functools.partial(run_intent, comp=Components(cfg), progress=progress, log=log)
+            slices, failure = [], None
+            for job in progress(jobs, "intents"):
+                try:
+                    slices.append(ex.map(fn, [job])[0])
+                except ExecutionError as e:
+                    failure = e.__cause__ or e
+                    break
+            if failure is not None:  # in this process: raise what the intent raised, as before executors
+                raise failure
+        else:
+            slices = ex.map(functools.partial(run_intent, echo=echo), jobs, chunksize=1)
+            if not echo:
+                for part in slices:
+                    for line in part["log"]:
+                        log(line)
+        where = {"name": ex.name, "max_workers": ex.max_workers}
+    results: dict[str, Any] = {"config": attrs.asdict(cfg), **{k: {} for k in SECTIONS}}
     timing: dict[str, float] = {}
-    results: dict[str, Any] = {"config": attrs.asdict(cfg), "sanity": {}, "rq1": {}, "rq2": {}, "scatter": {},
-                               "rq3": {}, "intents": {}}
+    for part in slices:
+        for k in SECTIONS:
+            results[k].update(part[k])
+        if part["errors"]:
+            results.setdefault("errors", []).extend(part["errors"])
+        for stage, sec in part["timing"].items():
+            timing[stage] = timing.get(stage, 0.0) + sec
+    results["timing"] = timing
+    results["manifest"] = manifest(cfg, lm=_merge_lm([part["lm"] for part in slices]))
+    results["manifest"]["executor"] = where
+    return results
+
+
+def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Progress | None = None,
+               log: Callable[[str], None] | None = None, echo: bool = False) -> dict:
+    """The whole run for one intent: training data, reward, intent inference, alignments, RQ1, scatter, RQ3.
+
+    Returns the intent's slice of the results: ``{section: {intent_id: ...}}`` for each of
+    :data:`SECTIONS` (empty when the stage did not run), ``errors`` (failed kernels), ``timing``
+    (seconds per stage), ``lm`` (identity and this intent's usage counters, or None) and ``log`` (lines
+    not yet shown: those that went neither to ``log`` nor, with ``echo``, to stderr).
+    ``comp``: default one :class:`Components` per config and worker process.
+    """
+    cfg, suite = job.cfg, job.suite
+    spec = suite.intent(job.intent_id)
+    if comp is None:
+        if cfg not in _WORKER_COMPONENTS:
+            _WORKER_COMPONENTS[cfg] = Components(cfg)
+        comp = _WORKER_COMPONENTS[cfg]
+    progress = progress or Progress(enabled=False)
+    lines: list[str] = []
+    say = log or (_echo if echo else lines.append)
+    usage_before = _lm_usage(comp)
+    cache = StageCache(Path(job.out), cfg.key())
+    results: dict[str, Any] = {k: {} for k in SECTIONS}
+    errors: list[str] = []
+    timing: dict[str, float] = {}
 
     def timed(stage: str, fn: Callable[[], Any]) -> Any:
         t0 = time.perf_counter()
@@ -288,97 +400,98 @@ def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: 
         timing[stage] = timing.get(stage, 0.0) + time.perf_counter() - t0
         return value
 
-    for spec in progress(intents, "intents"):
-        log(f"[{spec.id}] training the reward on {cfg.robot}")
-        demos, alts, pairs, train_specs = timed("train data", lambda: training_data(comp, suite, spec, cfg.robot))
-        reward = timed("train reward", lambda: gift.get_reward_model(cfg.reward).fit(demos, alts))
+    say(f"[{spec.id}] training the reward on {cfg.robot}")
+    demos, alts, pairs, train_specs = timed("train data", lambda: training_data(comp, suite, spec, cfg.robot,
+                                                                                job.seeds["train"]))
+    reward = timed("train reward", lambda: gift.get_reward_model(cfg.reward).fit(demos, alts))
 
-        # ---- intent
-        needs_intent = any(gift.get_manager().get("kernel", k).factory.uses_intent for k in cfg.kernels)
-        if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
-            def _infer():
-                main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
-                reps = [intent_to_json(infer_intent(comp, spec, pairs, seed=r + 1, temperature=0.7)).get("text")
-                        for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps")]
-                return {"main": main, "reps": reps}
+    # ---- intent
+    needs_intent = any(gift.get_manager().get("kernel", k).factory.uses_intent for k in cfg.kernels)
+    if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
+        def _infer():
+            main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
+            reps = [intent_to_json(infer_intent(comp, spec, pairs, seed=r + 1, temperature=0.7)).get("text")
+                    for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps")]
+            return {"main": main, "reps": reps}
 
-            inferred = timed("intent", lambda: cache.get_or_compute(f"intent-{spec.id}", _infer))
-            intent = intent_from_json(inferred["main"])
-            if inferred["reps"]:
-                texts = inferred["reps"]
-                cos_inf = text_cosine(texts, spec.text)
-                cos_gen = text_cosine([GENERIC_INTENT], spec.text)
-                results["sanity"][spec.id] = {"inferred": list(mean_se(cos_inf)),
-                                              "generic": [float(cos_gen[0]), 0.0], "texts": texts}
-        else:
-            from gift_kernels.evaluation import ground_truth_intent
+        inferred = timed("intent", lambda: cache.get_or_compute(f"intent-{spec.id}", _infer))
+        intent = intent_from_json(inferred["main"])
+        if inferred["reps"]:
+            texts = inferred["reps"]
+            cos_inf = text_cosine(texts, spec.text)
+            cos_gen = text_cosine([GENERIC_INTENT], spec.text)
+            results["sanity"][spec.id] = {"inferred": list(mean_se(cos_inf)),
+                                          "generic": [float(cos_gen[0]), 0.0], "texts": texts}
+    else:
+        from gift_kernels.evaluation import ground_truth_intent
 
-            intent = ground_truth_intent(spec)
-        results["intents"][spec.id] = intent_to_json(intent)
+        intent = ground_truth_intent(spec)
+    results["intents"][spec.id] = intent_to_json(intent)
 
-        # ---- alignments (once per kernel; independent of the number of trajectories)
-        aligned: dict[str, dict[str, tuple[Alignment, dict]]] = {}
-        for kname in progress(cfg.kernels, f"{spec.id}: kernels"):
-            try:
-                d = timed(f"align {kname}", lambda: cache.get_or_compute(
-                    f"align-{spec.id}-{kname}", lambda: align_kernel(comp, suite, spec, kname, intent,
-                                                                     cfg.thresholds)))
-            except Exception as e:  # noqa: BLE001 - keep what the other kernels computed
-                log(f"[{spec.id}] kernel {kname} failed: {type(e).__name__}: {e}")
-                results.setdefault("errors", []).append(f"{spec.id}/{kname}: {type(e).__name__}: {e}")
+    # ---- alignments (once per kernel; independent of the number of trajectories)
+    aligned: dict[str, dict[str, tuple[Alignment, dict]]] = {}
+    for kname in progress(cfg.kernels, f"{spec.id}: kernels"):
+        try:
+            d = timed(f"align {kname}", lambda: cache.get_or_compute(
+                f"align-{spec.id}-{kname}", lambda: align_kernel(comp, suite, spec, kname, intent, cfg.thresholds)))
+        except Exception as e:  # noqa: BLE001 - keep what the other kernels computed
+            say(f"[{spec.id}] kernel {kname} failed: {type(e).__name__}: {e}")
+            errors.append(f"{spec.id}/{kname}: {type(e).__name__}: {e}")
+            continue
+        for th, r in d.items():
+            aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
+                                                 r["metrics"])
+            results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
+    oracle = oracle_alignment(spec)
+
+    # ---- RQ1
+    main_th = cfg.thresholds[0]
+    per_kernel: dict[str, list[float]] = {}
+    for seed in progress(job.seeds["rq1"], f"{spec.id}: RQ1 seeds"):
+        scene = test_scene(comp, suite, spec, cfg.robot, seed)
+        sim = comp.simulator(cfg.robot)
+        task = gift.get_task(spec.task)
+        specs = task.feature_specs(scene.object_names)
+        feats = FeatureBatch.concat([
+            _features(sim, sim.generate(scene, g, cfg.trajectories_per_generator, _seed(seed, g)), spec.task,
+                      specs) for g in ("preferred", "default", "random")])
+        truth = task.ground_truth_reward(feats, sorted(scene.relevant))
+        pairs_idx = sample_pairs(len(feats), cfg.pairs, np.random.default_rng(seed))
+        for kname, by_th in list(aligned.items()) + [(ORACLE, {main_th: (oracle, {})})]:
+            if main_th not in by_th:
                 continue
-            for th, r in d.items():
-                aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
-                                                     r["metrics"])
-                results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
-        oracle = oracle_alignment(spec)
+            pred = reward.score_aligned(feats, by_th[main_th][0])
+            per_kernel.setdefault(kname, []).append(pairwise_win_rate(pred, truth, pairs_idx))
+    results["rq1"][spec.id] = {k: {"mean": mean_se(v)[0], "se": mean_se(v)[1], "per_seed": v}
+                               for k, v in per_kernel.items()}
 
-        # ---- RQ1
-        main_th = cfg.thresholds[0]
-        per_kernel: dict[str, list[float]] = {}
-        for s in progress(range(cfg.seeds), f"{spec.id}: RQ1 seeds"):
-            seed = _seed("rq1", spec.id, s)
-            scene = test_scene(comp, suite, spec, cfg.robot, seed)
-            sim = comp.simulator(cfg.robot)
-            task = gift.get_task(spec.task)
-            specs = task.feature_specs(scene.object_names)
-            feats = FeatureBatch.concat([
-                _features(sim, sim.generate(scene, g, cfg.trajectories_per_generator, _seed(seed, g)), spec.task,
-                          specs) for g in ("preferred", "default", "random")])
-            truth = task.ground_truth_reward(feats, sorted(scene.relevant))
-            pairs_idx = sample_pairs(len(feats), cfg.pairs, np.random.default_rng(seed))
-            for kname, by_th in list(aligned.items()) + [(ORACLE, {main_th: (oracle, {})})]:
-                if main_th not in by_th:
-                    continue
-                pred = reward.score_aligned(feats, by_th[main_th][0])
-                per_kernel.setdefault(kname, []).append(pairwise_win_rate(pred, truth, pairs_idx))
-        results["rq1"][spec.id] = {k: {"mean": mean_se(v)[0], "se": mean_se(v)[1], "per_seed": v}
-                                   for k, v in per_kernel.items()}
+    # ---- scatter (language vs vision similarity to the first relevant training object)
+    if {"language", "vision"} <= set(cfg.kernels) and spec.relevant_train:
+        anchor = suite.objects[spec.relevant_train[0]]
+        test = suite.specs(spec.test_objects)
+        lang = comp.kernel("language").similarity(test, [anchor])[:, 0]
+        vis = comp.kernel("vision").similarity(test, [anchor])[:, 0]
+        results["scatter"][spec.id] = {"anchor": anchor.name, "points": [
+            {"object": o.name, "language": float(a), "vision": float(b), "relevant": t.relevant}
+            for o, a, b, t in zip(test, lang, vis, spec.test)]}
 
-        # ---- scatter (language vs vision similarity to the first relevant training object)
-        if {"language", "vision"} <= set(cfg.kernels) and spec.relevant_train:
-            anchor = suite.objects[spec.relevant_train[0]]
-            test = suite.specs(spec.test_objects)
-            lang = comp.kernel("language").similarity(test, [anchor])[:, 0]
-            vis = comp.kernel("vision").similarity(test, [anchor])[:, 0]
-            results["scatter"][spec.id] = {"anchor": anchor.name, "points": [
-                {"object": o.name, "language": float(a), "vision": float(b), "relevant": t.relevant}
-                for o, a, b, t in zip(test, lang, vis, spec.test)]}
-
-        # ---- RQ3 (pack and store, on the second robot)
-        if cfg.rq3 and spec.task in ("pack_backpack", "store_drawer"):
-            results["rq3"][spec.id] = timed("rq3", lambda: rq3(comp, suite, spec, reward, aligned, oracle, main_th,
-                                                              progress))
-        log(f"[{spec.id}] done: " + ", ".join(f"{k}={v['mean']:.3f}" for k, v in results["rq1"][spec.id].items()))
-
-    results["timing"] = timing
-    results["manifest"] = manifest(cfg, comp)
-    return results
+    # ---- RQ3 (pack and store, on the second robot)
+    if cfg.rq3 and spec.task in ("pack_backpack", "store_drawer"):
+        results["rq3"][spec.id] = timed("rq3", lambda: rq3(comp, suite, spec, reward, aligned, oracle, main_th,
+                                                          progress, seeds=job.seeds["rq3"]))
+    say(f"[{spec.id}] done: " + ", ".join(f"{k}={v['mean']:.3f}" for k, v in results["rq1"][spec.id].items()))
+    lm = None
+    if comp._lm is not None:
+        lm = {"identity": comp._lm.identity(), "usage": _usage_delta(usage_before, _lm_usage(comp))}
+    return {**results, "errors": errors, "timing": timing, "lm": lm, "log": lines}
 
 
 def rq3(comp: Components, suite: Suite, spec: IntentSpec, reward, aligned, oracle, threshold: str,
-        progress: Progress) -> dict:
-    """Four candidates, each acting on a different held-out object; Boltzmann over aligned rewards."""
+        progress: Progress, seeds: Sequence[int] | None = None) -> dict:
+    """Four candidates, each acting on a different held-out object; Boltzmann over aligned rewards.
+
+    ``seeds``: one per base scene (default ``_seed("rq3", spec.id, s)``, see :func:`intent_seeds`).
+    """
     sim = comp.simulator(comp.cfg.rq3_robot)
     task = gift.get_task(spec.task)
     rel = [t.object for t in spec.test if t.relevant]
@@ -387,8 +500,9 @@ def rq3(comp: Components, suite: Suite, spec: IntentSpec, reward, aligned, oracl
     objects = (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
     specs = task.feature_specs(objects)
     probs: dict[str, list[np.ndarray]] = {}
-    for s in progress(range(comp.cfg.seeds), f"{spec.id}: RQ3"):
-        seed = _seed("rq3", spec.id, s)
+    if seeds is None:
+        seeds = [_seed("rq3", spec.id, s) for s in range(comp.cfg.seeds)]
+    for seed in progress(seeds, f"{spec.id}: RQ3"):
         base = sim.make_scene(spec.task, suite.specs(objects), [o for o in objects if o in rel], seed=seed)
         feats = FeatureBatch.concat([
             _features(sim, sim.generate(attrs.evolve(base, relevant=frozenset({o})), "preferred", 1,
@@ -402,8 +516,50 @@ def rq3(comp: Components, suite: Suite, spec: IntentSpec, reward, aligned, oracl
             for k, v in probs.items()}
 
 
-def manifest(cfg: ReproduceConfig, comp: Components) -> dict:
-    """Package versions, seeds, model identity and hash, LM usage and cache hits."""
+def _lm_usage(comp: Components) -> dict[str, Any] | None:
+    """The public usage counters of ``comp``'s LM (None when it was not built or has no counters)."""
+    if comp._lm is None:
+        return None
+    stats = getattr(comp._lm, "stats", None)
+    if stats is None:
+        return None
+    return {k: v for k, v in (attrs.asdict(stats, recurse=False) if attrs.has(type(stats))
+                              else vars(stats)).items() if not k.startswith("_")}
+
+
+def _add(a: Any, b: Any, sign: int = 1) -> Any:
+    """``a + sign * b`` for usage counters; None (no price) counts as nothing, None + None stays None."""
+    if a is None and b is None:
+        return None
+    return (a or 0) + sign * (b or 0)
+
+
+def _usage_delta(before: dict[str, Any] | None, after: dict[str, Any] | None) -> dict[str, Any] | None:
+    """Counters spent between two :func:`_lm_usage` snapshots of one LM."""
+    if after is None:
+        return None
+    before = before or {}
+    return {k: (v if k not in before else _add(v, before[k], -1)) for k, v in after.items()}
+
+
+def _merge_lm(parts: Sequence[dict[str, Any] | None]) -> dict[str, Any] | None:
+    """One ``{"identity", "usage"}`` from the intents' (usage counters summed; None when no intent used an LM)."""
+    used = [p for p in parts if p is not None]
+    if not used:
+        return None
+    usage: dict[str, Any] | None = None
+    for p in used:
+        if p.get("usage") is not None:
+            usage = dict(p["usage"]) if usage is None else {k: _add(usage.get(k), v) for k, v in p["usage"].items()}
+    return {"identity": used[0]["identity"], "usage": usage}
+
+
+def manifest(cfg: ReproduceConfig, comp: Components | None = None, *, lm: dict[str, Any] | None = None) -> dict:
+    """Package versions, seeds, model identity and hash, LM usage and cache hits.
+
+    ``lm``: ``{"identity", "usage"}`` summed over the workers of a run (:func:`run`); without it, read
+    from ``comp``'s LM (its counters since it was built).
+    """
     versions = {}
     for dist in ("gift", "gift-llm", "gift-kernels", "gift-rewards", "gift-sim-drake", "gift-experiments", "drake",
                  "numpy", "torch", "llama-cpp-python", "litellm", "sentence-transformers"):
@@ -413,14 +569,12 @@ def manifest(cfg: ReproduceConfig, comp: Components) -> dict:
             pass
     m: dict[str, Any] = {"python": platform.python_version(), "platform": platform.platform(),
                          "versions": versions, "config_key": cfg.key()}
-    if comp._lm is not None:
-        lm = comp._lm
-        m["lm"] = {"identity": lm.identity()}
-        stats = getattr(lm, "stats", None)
-        if stats is not None:
-            public = {k: v for k, v in (attrs.asdict(stats, recurse=False) if attrs.has(type(stats))
-                                        else vars(stats)).items() if not k.startswith("_")}
-            m["lm"]["usage"] = public
+    if lm is None and comp is not None and comp._lm is not None:
+        lm = {"identity": comp._lm.identity(), "usage": _lm_usage(comp)}
+    if lm is not None:
+        m["lm"] = {"identity": lm["identity"]}
+        if lm.get("usage") is not None:
+            m["lm"]["usage"] = lm["usage"]
         try:
             from gift_llm.embedded import EXPECTED_SHA256
 
