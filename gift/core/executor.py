@@ -208,6 +208,9 @@ class Executor(abc.ABC):
     name: ClassVar[str]
     #: True when ``fn`` runs in the calling process (callers may then pass it unpicklable callbacks).
     in_process: ClassVar[bool] = False
+    #: True when what ``fn`` prints to stderr reaches the caller's stderr at once and reliably (a worker
+    #: may then print its own progress lines); False when it is forwarded late or may be lost (Ray).
+    live_stderr: ClassVar[bool] = False
 
     @property
     @abc.abstractmethod
@@ -242,6 +245,7 @@ class SerialExecutor(Executor):
 
     name: ClassVar[str] = "serial"
     in_process: ClassVar[bool] = True
+    live_stderr: ClassVar[bool] = True
 
     def __init__(self, max_workers: int | None = None) -> None:
         if max_workers not in (None, 1):
@@ -280,6 +284,7 @@ class LocalExecutor(Executor):
     """
 
     name: ClassVar[str] = "local"
+    live_stderr: ClassVar[bool] = True  # spawned workers inherit the caller's stderr
 
     def __init__(self, max_workers: int | None = None, *, threads_per_worker: int | None = None,
                  start_method: str = "spawn") -> None:

@@ -58,9 +58,9 @@ def run_reproduce(args: argparse.Namespace) -> int:
     cfg = _config_from_args(args)
     out = Path(args.out)
     t0 = time.perf_counter()
-    with executor_from_args(args) as executor:  # pool workers print their intents' log lines themselves
+    with executor_from_args(args) as executor:  # local workers print their intents' log lines themselves
         results = run(cfg, out, Progress(enabled=not args.quiet), log=_log, executor=executor,
-                      echo=not executor.in_process)
+                      echo=not executor.in_process and executor.live_stderr)
     results["timing"]["total"] = time.perf_counter() - t0
     argv = sys.argv[sys.argv.index("reproduce"):] if "reproduce" in sys.argv else ["reproduce"]
     path = write_report(results, out, command="gift " + " ".join(shlex.quote(a) for a in argv))

@@ -327,8 +327,8 @@ def run(cfg: ReproduceConfig, out: Path, progress: Progress | None = None, log: 
     same on every executor. ``serial`` runs the intents one after the other in this process with
     ``progress`` bars and ``log`` lines as they happen. A pool runs them in one ``map``, each worker
     building its own components; ``log`` then gets each intent's lines when the map returns, unless
-    ``echo=True``, which makes the workers print them to stderr as they happen. Executor options do not
-    change results and are not part of ``cfg``.
+    ``echo=True`` (for executors with ``live_stderr``, e.g. ``local``), which makes the workers print them
+    to stderr as they happen. Executor options do not change results and are not part of ``cfg``.
     """
     progress = progress or Progress()
     suite = gift.load_suite(cfg.suite)

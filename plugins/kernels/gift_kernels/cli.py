@@ -150,7 +150,7 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
         result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
                                     lm=args.lm, intents=intents, progress=progress,
                                     checkpoint=write if args.out else None, executor=executor,
-                                    echo=progress is not None and not executor.in_process)
+                                    echo=progress is not None and not executor.in_process and executor.live_stderr)
     print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
     failed = [k for k, d in result["kernels"].items() if d["errors"]]
     return 1 if len(failed) == len(kernels) else 0

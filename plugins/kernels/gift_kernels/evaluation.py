@@ -445,8 +445,9 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     the same on every executor. ``serial`` runs the items one after the other in this process, calling
     ``progress(line)`` and ``checkpoint(result_so_far)`` after every kernel x intent (so an interrupted
     run keeps what it computed). A pool runs every item in one ``map``; ``progress`` and ``checkpoint``
-    are then called when it returns, except that with ``echo=True`` the workers print each item's
-    progress line to stderr as soon as it is done (and ``progress`` does not repeat it).
+    are then called when it returns, except that with ``echo=True`` (for executors with ``live_stderr``,
+    e.g. ``local``) the workers print each item's progress line to stderr as soon as it is done (and
+    ``progress`` does not repeat it).
     """
     if isinstance(suite, str):
         suite = load_suite(suite)
