@@ -11,6 +11,7 @@ Every function takes one item that carries its own seed, so its result cannot de
 - :func:`score_batch`: one evaluation-sweep item: roll out a batch, score it with a fitted reward model
   (shipped once per chunk inside a ``functools.partial``) and with the family's ground truth.
 - :func:`limited_call`: holds a concurrency limit while "calling an LM", writing enter/exit timestamps.
+- :func:`llama_threads`: the thread budget an embedded llama.cpp model would get in this worker.
 """
 
 from __future__ import annotations
@@ -138,3 +139,10 @@ def ask_lm(cache_path: str, limit: Any, item: tuple[str, int]) -> tuple[str, boo
     lm = _cached_lm(cache_path, limit, 512)
     out = lm.complete([gift.Message("user", question)], temperature=0.0, seed=int(seed), max_tokens=6)
     return out.text, bool(out.usage.cached)
+
+
+def llama_threads(_item: Any) -> tuple[int, str | None]:
+    """``(threads a llamacpp model loaded here would use, $OMP_NUM_THREADS)`` in this worker process."""
+    from gift_llm.backends.llamacpp import default_threads
+
+    return default_threads(), os.environ.get("OMP_NUM_THREADS")
