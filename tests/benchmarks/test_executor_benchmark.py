@@ -1,13 +1,17 @@
 """Throughput of sweeps on 1 vs 2 workers: serial (the naive baseline), local process pool, Ray.
 
-Three workloads from ``tests/executor/executor_sweeps.py``, seeded items (8 Drake scenes, else 24) per round:
+Four workloads (the first three from ``tests/executor/executor_sweeps.py``), seeded items (8 Drake scenes, else 24)
+per round:
 
 - ``drake``: trajectory generation with the Drake simulator ``drake-jaco`` (one new scene per item and
   round, ``make_scene`` + 32 preferred rollouts + features; the feature batches travel back);
 - ``evaluation``: an evaluation sweep that scores 512 new synthetic rollouts per item with a fitted
   ``maxent-linear`` reward (shipped once per chunk) and the ground truth; only scores travel back;
 - ``cached-lm``: LM questions answered from the LM plugin's SQLite cache at a shared path (4 distinct
-  questions asked 6 times each, cache filled by the embedded llama.cpp model before timing).
+  questions asked 6 times each, cache filled by the embedded llama.cpp model before timing);
+- ``cached-evaluation``: ``gift evaluate-alignment`` items (one (kernel, intent) each, the suite travels with
+  the item) of the ``language`` kernel on the 6 intents of ``gift-paper``, 4 times over, with every MiniLM
+  embedding already in the cache: scoring, thresholds and metrics, no model call.
 
 Pools are started and warmed on other items before timing (steady-state throughput); ``extra_info`` records items/s.
 Nothing here asserts anything about time; each benchmark checks its results against serial ones.
@@ -136,3 +140,27 @@ def test_cached_lm_sweep_throughput(benchmark, executors, filled_lm_cache, confi
     want = [(a, True) for a in answers] * (N_ITEMS // 4)
     _run(benchmark, executors, config, functools.partial(sweeps.ask_lm, path, None), lambda r: LM_ITEMS,
          lambda items, res: res == want)
+
+
+@pytest.fixture(scope="module")
+def evaluation_items():
+    """``evaluate-alignment`` items of the language kernel on every gift-paper intent; embeddings cached here."""
+    from gift_kernels.alignment import THRESHOLDS
+    from gift_kernels.evaluation import AlignmentItem, evaluate_item
+
+    suite = gift.load_suite("gift-paper")
+    items = [AlignmentItem(suite, "language", spec.id, THRESHOLDS) for spec in suite.intents]
+    ref = SerialExecutor().map(evaluate_item, items)  # computes and caches every MiniLM vector
+    assert all(o.result is not None for o in ref), [o.error for o in ref]
+    n = N_ITEMS // len(items)
+    return items * n, [o.result.scores.decision.tobytes() for o in ref] * n
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("config", CONFIGS)
+def test_cached_evaluation_sweep_throughput(benchmark, executors, evaluation_items, config):
+    from gift_kernels.evaluation import evaluate_item
+
+    items, want = evaluation_items
+    _run(benchmark, executors, config, evaluate_item, lambda r: items,
+         lambda items, res: [o.result.scores.decision.tobytes() for o in res] == want)
