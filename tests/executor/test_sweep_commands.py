@@ -209,3 +209,20 @@ def test_llamacpp_threads_follow_the_worker_budget(local_executor, monkeypatch, 
     monkeypatch.delenv("OMP_NUM_THREADS")
     llamacpp.LlamaCppLM(model, n_ctx=2048).llama
     assert [(m["n_threads"], m["n_threads_batch"]) for m in made] == [(1, 1), (3, 3), (os.cpu_count(),) * 2]
+
+
+def test_evaluate_alignment_inferred_intents_failing_the_same_way_on_serial_and_local(local_executor):
+    """Inferred intents run as their own items first (on a pool); an LM that cannot be built fails every
+    intent of every kernel, reported in the result, the same on both executors."""
+    from gift_kernels.evaluation import evaluate_alignment
+
+    got = {}
+    for name, executor in (("serial", "serial"), ("local", local_executor)):
+        lines: list[str] = []
+        result = evaluate_alignment(str(SUITE), ["language", "vision"], intent_source="inferred",
+                                    lm="no-such-backend:x", progress=lines.append, executor=executor)
+        assert len(lines) == 4 and all(": FAILED LMError: unknown LM 'no-such-backend:x'" in line for line in lines)
+        got[name] = json.dumps(without(result, {"seconds"}))
+    assert got["serial"] == got["local"]
+    kernels = json.loads(got["serial"])["kernels"]
+    assert all(set(k["errors"]) == set(INTENTS) and not k["intents"] for k in kernels.values())
