@@ -145,10 +145,10 @@ class Components:
             self._kernels[name] = gift.get_kernel(name, **opts)
         return self._kernels[name]
 
-    def estimator(self, seed: int = 0, temperature: float = 0.0):
+    def estimator(self, seed: int = 0, temperature: float = 0.0, axes: bool | None = None):
         # Call 2 (semantic axes) only feeds the binary `gift` kernel's prompt; skip it when no kernel reads it
         return gift.get_intent_estimator("lm-contrastive", lm=self.lm, seed=seed, temperature=temperature,
-                                         axes="gift" in self.cfg.kernels)
+                                         axes=("gift" in self.cfg.kernels) if axes is None else axes)
 
 
 # ----------------------------------------------------------------------------- data generation
@@ -217,9 +217,10 @@ def test_scene(comp: Components, suite: Suite, spec: IntentSpec, robot: str, see
 
 
 def infer_intent(comp: Components, spec: IntentSpec, pairs: Sequence[DemonstrationPair], seed: int = 0,
-                 temperature: float = 0.0) -> Intent:
+                 temperature: float = 0.0, axes: bool | None = None) -> Intent:
+    """Calls 1 (and 2 when ``axes``; default: when a kernel reads the axes) on the first ``sanity_pairs`` pairs."""
     task = gift.get_task(spec.task)
-    est = comp.estimator(seed=seed, temperature=temperature)
+    est = comp.estimator(seed=seed, temperature=temperature, axes=axes)
     return est.estimate(list(pairs)[: comp.cfg.sanity_pairs], task_context=task.context(),
                         objects=spec.train_objects)
 
@@ -410,9 +411,14 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
     if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
         def _infer():
             main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
-            reps = [intent_to_json(infer_intent(comp, spec, pairs, seed=r + 1, temperature=0.7)).get("text")
-                    for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps")]
-            return {"main": main, "reps": reps}
+            reps, rep_errors = [], []
+            for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps"):
+                try:  # the sanity check reads only the text: no Call 2
+                    reps.append(infer_intent(comp, spec, pairs, seed=r + 1, temperature=0.7, axes=False).text)
+                except GiftError as e:  # a sampled answer that stays invalid after repairs: count it, go on
+                    rep_errors.append(f"repetition {r + 1}: {type(e).__name__}: {e}")
+                    say(f"[{spec.id}] intent repetition {r + 1} failed: {type(e).__name__}: {e}")
+            return {"main": main, "reps": reps, "rep_errors": rep_errors}
 
         inferred = timed("intent", lambda: cache.get_or_compute(f"intent-{spec.id}", _infer))
         intent = intent_from_json(inferred["main"])
@@ -421,7 +427,10 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
             cos_inf = text_cosine(texts, spec.text)
             cos_gen = text_cosine([GENERIC_INTENT], spec.text)
             results["sanity"][spec.id] = {"inferred": list(mean_se(cos_inf)),
-                                          "generic": [float(cos_gen[0]), 0.0], "texts": texts}
+                                          "generic": [float(cos_gen[0]), 0.0], "texts": texts,
+                                          "failed": len(inferred.get("rep_errors", []))}
+        for err in inferred.get("rep_errors", []):
+            errors.append(f"{spec.id}/intent {err}")
     else:
         from gift_kernels.evaluation import ground_truth_intent
 

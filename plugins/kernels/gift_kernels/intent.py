@@ -17,13 +17,14 @@ and then fewer features per pair (down to 2) are shown until it fits.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
 
 from gift.core.data import DemonstrationPair, Intent, Motivation, SemanticAxis
-from gift.core.errors import GiftError, ValidationError
+from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import IntentEstimator, LMBackend
 from gift_kernels import prompts
 from gift_kernels.lm_kernels import resolve_lm
@@ -185,9 +186,15 @@ class LMContrastiveIntentEstimator(IntentEstimator):
             return []
         messages = prompts.axes_messages([(m.text, m.features) for m in motivations], objects)
         self.calls += 1
-        answer = ask_dict(self.lm, messages, validate=lambda d: parse_axes(d, objects) and None,
-                          max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
-                          required_keys=("axes",))
+        try:
+            answer = ask_dict(self.lm, messages, validate=lambda d: parse_axes(d, objects) and None,
+                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
+                              required_keys=("axes",))
+        except LMAnswerError as e:
+            # the axes refine the intent; without valid ones it keeps Call 1's similarities (see estimate)
+            warnings.warn(f"lm-contrastive: Call 2 gave no valid semantic axes, keeping Call 1's similarities "
+                          f"({e})", RuntimeWarning, stacklevel=2)
+            return []
         return parse_axes(answer, objects)
 
     def estimate(self, demonstrations: Sequence[DemonstrationPair], *, task_context: str = "",
