@@ -29,6 +29,7 @@ from gift.core.data import DemonstrationPair, Intent
 from gift.core.errors import GiftError
 from gift.core.executor import Executor, using_executor
 from gift.core.metrics import binary_metrics, roc_auc
+from gift.core.serialization import to_jsonable
 from gift.core.suite import SUBSETS, IntentSpec, Suite, load_suite
 from gift_kernels.alignment import THRESHOLDS, AlignmentScores, score_alignment
 
@@ -611,12 +612,4 @@ def _f(x: float) -> str:
 
 
 def _jsonable(x: Any) -> Any:
-    if isinstance(x, Mapping):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return None if math.isnan(float(x)) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    return x
+    return to_jsonable(x, nonfinite="null-nan")

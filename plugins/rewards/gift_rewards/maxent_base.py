@@ -30,6 +30,7 @@ from gift.core.alignment import AlignmentPlan, plan_alignment
 from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec
 from gift.core.errors import GiftError, ValidationError
 from gift.core.interfaces import RewardModel
+from gift.core.serialization import to_jsonable
 from gift_rewards.trajectory_features import check_batch
 
 FORMAT = "gift-reward"
@@ -236,14 +237,4 @@ def read_reward_file(path: str | Path) -> dict[str, Any]:
 
 
 def _jsonable(value: Any) -> Any:
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return str(value)
-    return value
+    return to_jsonable(value, nonfinite="string")

@@ -14,6 +14,7 @@ import numpy as np
 
 from gift.core.data import FeatureBatch, FeatureSpec, ObjectSpec, TrajectoryBatch
 from gift.core.errors import GiftError
+from gift.core.serialization import to_jsonable
 
 FORMAT_VERSION = 1
 _ARRAYS = ("joint_positions", "ee_positions", "object_positions", "landmark_positions")
@@ -25,15 +26,7 @@ def _stem(path: str | os.PathLike) -> Path:
 
 
 def _jsonable(value):
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
+    return to_jsonable(value)
 
 
 def save_dataset(path: str | os.PathLike, trajectories: TrajectoryBatch,
