@@ -90,17 +90,21 @@ def _canonical(raw: Sequence[Any], known: Mapping[str, str], unknown: list[str])
     return tuple(names)
 
 
-def parse_axes(answer: Mapping[str, Any], objects: Sequence[str]) -> list[SemanticAxis]:
-    """Validate Call 2: axes (yes/no questions) over object names that exist; unknown names raise."""
+def parse_axes(answer: Mapping[str, Any], objects: Sequence[str], strict: bool = True) -> list[SemanticAxis]:
+    """Validate Call 2: axes (yes/no questions) over object names that exist.
+
+    ``strict``: unknown names raise (the repair request names them); else they are dropped, and so are
+    axes left without an object.
+    """
     known = {_norm(o): o for o in objects}
     if "axes" not in answer:
         raise ValidationError(f"the answer has no 'axes' key (keys: {list(answer)})")
     axes, unknown = [], []
     for q, objs in _entries(answer["axes"], "objects"):
         axes.append(SemanticAxis(question=q, objects=_canonical(objs, known, unknown)))
-    if unknown:
+    if unknown and strict:
         raise ValidationError(f"objects {sorted(set(unknown))} do not exist; use only: {list(objects)}")
-    return axes
+    return axes if strict else [a for a in axes if a.objects]
 
 
 class LMContrastiveIntentEstimator(IntentEstimator):
@@ -180,7 +184,7 @@ class LMContrastiveIntentEstimator(IntentEstimator):
 
     def semantic_axes(self, motivations: Sequence[Motivation], objects: Sequence[str]) -> list[SemanticAxis]:
         """Call 2: yes/no questions grouping ``objects`` under the motivations (names validated)."""
-        from gift_llm.structured import ask_dict
+        from gift_llm.structured import ask_dict, extract_dict
 
         if not objects:
             return []
@@ -191,10 +195,17 @@ class LMContrastiveIntentEstimator(IntentEstimator):
                               max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
                               required_keys=("axes",))
         except LMAnswerError as e:
-            # the axes refine the intent; without valid ones it keeps Call 1's similarities (see estimate)
-            warnings.warn(f"lm-contrastive: Call 2 gave no valid semantic axes, keeping Call 1's similarities "
-                          f"({e})", RuntimeWarning, stacklevel=2)
-            return []
+            # the axes refine the intent: keep the last answer's axes without the names that do not exist;
+            # with none left, the intent keeps Call 1's similarities (see estimate)
+            try:
+                kept = parse_axes(extract_dict(e.raw), objects, strict=False)
+            except (LMAnswerError, ValueError):
+                kept = []
+            what = (f"kept {len(kept)} axes without the unknown names" if kept
+                    else "no valid semantic axes, keeping Call 1's similarities")
+            warnings.warn(f"lm-contrastive: Call 2 still invalid after {self.max_repairs} repairs: {what} "
+                          f"({str(e).splitlines()[0]})", RuntimeWarning, stacklevel=2)
+            return kept
         return parse_axes(answer, objects)
 
     def estimate(self, demonstrations: Sequence[DemonstrationPair], *, task_context: str = "",
