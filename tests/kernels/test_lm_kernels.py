@@ -119,6 +119,18 @@ def test_gift_kernel_gives_up_with_the_raw_answer_after_the_repairs():
     assert "crayons are art" in str(e.value) and len(lm.calls) == 2
 
 
+def test_gift_kernel_keeps_the_valid_part_of_an_answer_still_incomplete_after_the_repairs():
+    # the 1.5B model often writes 'none' or leaves objects out, also when asked again
+    answer = json.dumps({"crayons": "paintbrush", "toothbrush": "none"})
+    lm = ScriptedLM(lambda m, s: answer)
+    kernel = MappingKernel(lm=lm, samples=2, max_repairs=1)
+    with pytest.warns(RuntimeWarning, match="2 of 3 objects defaulted to 'distractor' after 1 repairs"):
+        votes = kernel.votes(TEST, TRAIN, ART)
+    assert votes.mode() == {"crayons": "paintbrush", "toothbrush": DISTRACTOR, "apple": DISTRACTOR}
+    assert len(lm.calls) == 4 and len(kernel.fallbacks) == 2  # 2 samples x (answer + 1 repair)
+    assert kernel.fallbacks[0].startswith("sample 0: 2 of 3 objects")
+
+
 # ----------------------------------------------------------------------------- gift-prob control flow
 
 

@@ -265,14 +265,18 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
     from gift_kernels.evaluation import REPORT_SUBSETS, _members, subset_metrics
 
     kernel = comp.kernel(kernel_name)
+    n_fallbacks = len(getattr(kernel, "fallbacks", ()))
     scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
                              intent if kernel.uses_intent else None, relevant_train=spec.relevant_train,
                              need=tuple(thresholds))
     labels = {t.object: t.relevant for t in spec.test}
     y = np.array([t.relevant for t in spec.test], dtype=bool)
+    fallbacks = list(getattr(kernel, "fallbacks", ()))[n_fallbacks:]  # LM answers completed by default
     out = {}
     for th in thresholds:
         cut, note = scores.threshold(th, labels)
+        if fallbacks:
+            note += "; LM answers completed by default: " + "; ".join(fallbacks)
         al = scores.alignment(cut)
         out[th] = {"cut": cut, "note": note, "mapping": dict(al.mapping), "scores": dict(al.scores),
                    "metrics": {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)], cut)

@@ -32,7 +32,7 @@ import attrs
 import numpy as np
 
 from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
-from gift.core.errors import GiftError, ValidationError
+from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift_kernels import prompts
 
@@ -58,12 +58,9 @@ def _object_names(objs: Sequence[ObjectSpec | str]) -> list[str]:
 # ============================================================================= Call 3 mapping kernels
 
 
-def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]) -> dict[str, str]:
-    """Validate a Call-3 answer: every test object mapped, targets only training objects or distractor.
-
-    Names are matched case- and whitespace-insensitively. Raises :class:`ValidationError` (a ValueError) naming what is
-    missing or unknown (``ask_dict`` turns that into a repair request).
-    """
+def _valid_part(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]
+                ) -> tuple[dict[str, str], list[str]]:
+    """``({test object: target}`` for the valid entries of a Call-3 answer, ``[unknown target entries])``."""
     def norm(s: Any) -> str:
         return " ".join(str(s).replace("_", " ").lower().split())
 
@@ -83,8 +80,22 @@ def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequenc
             unknown_targets.append(f"{k!r} -> {v!r}")
             continue
         out[t] = target
+    return out, unknown_targets
+
+
+def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str],
+                  strict: bool = True) -> dict[str, str]:
+    """Validate a Call-3 answer: every test object mapped, targets only training objects or distractor.
+
+    Names are matched case- and whitespace-insensitively. ``strict``: raises :class:`ValidationError` (a
+    ValueError) naming what is missing or unknown (``ask_dict`` turns that into a repair request); else
+    an unmapped object or an unknown target becomes ``distractor`` (aligned to nothing).
+    """
+    out, unknown_targets = _valid_part(answer, test, train)
     problems = []
     missing = [t for t in test if t not in out]
+    if not strict:
+        return {t: out.get(t, DISTRACTOR) for t in test}
     if unknown_targets:
         problems.append(f"unknown targets {unknown_targets}; allowed: {list(train)} or {DISTRACTOR!r}")
     if missing:
@@ -131,6 +142,7 @@ class MappingKernel(SimilarityKernel):
         self.samples, self.temperature, self.seed = samples, float(temperature), int(seed)
         self.use_intent, self.max_repairs = bool(use_intent), int(max_repairs)
         self.calls = 0  # LM calls made (including those served from the LM cache)
+        self.fallbacks: list[str] = []  # samples completed by default (see _sample)
 
     @property
     def lm(self) -> LMBackend:
@@ -139,15 +151,32 @@ class MappingKernel(SimilarityKernel):
         return self._lm
 
     def _sample(self, test: list[str], train: list[str], intent: Intent | None, k: int) -> dict[str, str]:
-        from gift_llm.structured import ask_dict
+        from gift_llm.structured import ask_dict, extract_dict
 
         rng = np.random.default_rng(self.seed * 1000 + k)
         t_order = [test[i] for i in rng.permutation(len(test))]
         s_order = [train[i] for i in rng.permutation(len(train))]
         messages = prompts.mapping_messages(t_order, s_order, intent)
         self.calls += 1
-        answer = ask_dict(self.lm, messages, validate=lambda d: parse_mapping(d, test, train),
-                          max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k)
+        try:
+            answer = ask_dict(self.lm, messages, validate=lambda d: parse_mapping(d, test, train),
+                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k)
+        except LMAnswerError as e:
+            # still incomplete after the repairs: keep the valid part of the last answer; an object it
+            # leaves unmapped (or maps to an unknown name) aligns to nothing, i.e. distractor. An answer
+            # without any dictionary is not a mapping at all: that error stands.
+            try:
+                partial = extract_dict(e.raw)
+            except (LMAnswerError, ValueError):
+                raise e from None
+            mapping = parse_mapping(partial, test, train, strict=False)
+            n_default = len(test) - len(_valid_part(partial, test, train)[0])
+            note = (f"sample {k}: {n_default} of {len(test)} objects defaulted to {DISTRACTOR!r} after "
+                    f"{self.max_repairs} repairs")
+            self.fallbacks.append(note)
+            warnings.warn(f"{self.name} kernel: {note} ({str(e).splitlines()[0][:300]})", RuntimeWarning,
+                          stacklevel=2)
+            return mapping
         return parse_mapping(answer, test, train)
 
     def votes(self, test: Sequence[ObjectSpec | str], train: Sequence[ObjectSpec | str],
