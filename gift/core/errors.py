@@ -27,6 +27,10 @@ class SuiteError(GiftError):
         super().__init__(f"{', '.join(where)}: {message}" if where else message)
 
 
+class PlacementError(GiftError):
+    """A simulator cannot lay out the requested objects in a scene (too many or too large for the table)."""
+
+
 class PluginError(GiftError):
     """A plugin problem: duplicate component names, an unknown component, a bad registration."""
 

@@ -73,7 +73,9 @@ class Simulator(abc.ABC):
     @abc.abstractmethod
     def make_scene(self, task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str],
                    seed: int) -> Scene:
-        """A randomised scene of family ``task`` (start, goal and placements from ``seed``)."""
+        """A randomised scene of family ``task`` (start, goal and placements from ``seed``).
+
+        Raises :class:`~gift.core.errors.PlacementError` when the objects do not fit on the table."""
 
     @abc.abstractmethod
     def generate(self, scene: Scene, generator: str, n: int, seed: int) -> TrajectoryBatch:

@@ -34,7 +34,7 @@ import numpy as np
 
 import gift
 from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatch, Intent, Scene
-from gift.core.errors import GiftError
+from gift.core.errors import GiftError, PlacementError
 from gift.core.executor import ExecutionError, Executor, using_executor
 from gift.core.metrics import boltzmann, mean_se, pairwise_win_rate, sample_pairs
 from gift.core.suite import IntentSpec, Suite
@@ -174,8 +174,7 @@ def training_data(comp: Components, suite: Suite, spec: IntentSpec, robot: str,
     demos, alts, pairs = [], [], []
     for k, seed in enumerate(seeds):
         # each training scene holds a random subset of the training objects (several configurations)
-        names = _pick(rel, irr, comp.cfg.test_objects_per_scene, np.random.default_rng(seed))
-        scene = sim.make_scene(spec.task, suite.specs(names), [n for n in names if n in rel], seed=seed)
+        scene = _placed_scene(sim, suite, spec.task, rel, irr, comp.cfg.test_objects_per_scene, seed)
         pref = _features(sim, sim.generate(scene, "preferred", comp.cfg.demos_per_scene, _seed("p", spec.id, k)),
                          spec.task, specs)
         default = _features(sim, sim.generate(scene, "default", comp.cfg.demos_per_scene, _seed("d", spec.id, k)),
@@ -208,9 +207,23 @@ def test_scene(comp: Components, suite: Suite, spec: IntentSpec, robot: str, see
     irr = [t.object for t in spec.test if not t.relevant]
     if not rel or not irr:
         raise GiftError(f"intent {spec.id!r} needs relevant and irrelevant test objects")
-    names = _pick(rel, irr, n_objects or comp.cfg.test_objects_per_scene, np.random.default_rng(seed))
-    relevant = [x for x in names if x in rel]
-    return comp.simulator(robot).make_scene(spec.task, suite.specs(names), relevant, seed=seed)
+    return _placed_scene(comp.simulator(robot), suite, spec.task, rel, irr,
+                         n_objects or comp.cfg.test_objects_per_scene, seed)
+
+
+def _placed_scene(sim, suite: Suite, task: str, rel: Sequence[str], irr: Sequence[str], n: int, seed: int,
+                  attempts: int = 20) -> Scene:
+    """A scene of ``n`` objects picked by :func:`_pick` from ``seed``; when they do not fit on the table,
+    the next pick of the same generator (deterministic), up to ``attempts`` picks."""
+    rng = np.random.default_rng(seed)
+    for attempt in range(attempts):
+        names = _pick(rel, irr, n, rng)
+        try:
+            return sim.make_scene(task, suite.specs(names), [x for x in names if x in rel], seed=seed)
+        except PlacementError as e:
+            last = e
+    raise PlacementError(f"{attempts} random picks of {n} objects for a {task} scene (seed {seed}) did not fit "
+                         f"on the table; last: {last}")
 
 
 # ----------------------------------------------------------------------------- intents
@@ -490,8 +503,12 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
 
     # ---- RQ3 (pack and store, on the second robot)
     if cfg.rq3 and spec.task in ("pack_backpack", "store_drawer"):
-        results["rq3"][spec.id] = timed("rq3", lambda: rq3(comp, suite, spec, reward, aligned, oracle, main_th,
-                                                          progress, seeds=job.seeds["rq3"]))
+        try:
+            results["rq3"][spec.id] = timed("rq3", lambda: rq3(comp, suite, spec, reward, aligned, oracle, main_th,
+                                                              progress, seeds=job.seeds["rq3"]))
+        except PlacementError as e:  # RQ3's four fixed objects may not fit on the table: keep RQ1/RQ2
+            say(f"[{spec.id}] RQ3 skipped: {e}")
+            errors.append(f"{spec.id}/rq3: {e}")
     say(f"[{spec.id}] done: " + ", ".join(f"{k}={v['mean']:.3f}" for k, v in results["rq1"][spec.id].items()))
     lm = None
     if comp._lm is not None:

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gift.core.data import ObjectSpec, Scene
-from gift.core.errors import GiftError
+from gift.core.errors import GiftError, PlacementError
 from gift_sim_drake.plant import CONTAINERS, MUG, footprint_radius, half_height
 
 #: Families this simulator can generate motion for, and the landmark each uses.
@@ -49,7 +49,7 @@ def _place(rng: np.random.Generator, radii: np.ndarray, sample, what: str, resta
                 break
         if len(out) == len(radii):
             return np.array([out[i] for i in range(len(radii))]).reshape(len(radii), 2)
-    raise GiftError(f"cannot place {len(radii)} objects of these sizes (footprint radii "
+    raise PlacementError(f"cannot place {len(radii)} objects of these sizes (footprint radii "
                     f"{np.round(radii, 3).tolist()} m) in the {what} region without overlap; use fewer or smaller "
                     f"objects")
 
