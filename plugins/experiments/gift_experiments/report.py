@@ -282,6 +282,11 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
                 lines.append(f"- {intent} / {k}: top choice **{v['objects'][best]}**, "
                              f"probability on relevant objects {mass:.2f}")
         lines.append("")
+    if results.get("errors"):
+        lines += ["## Failures and fallbacks", "",
+                  "What failed and was skipped, and LM answers completed by default (an object an answer leaves "
+                  "unmapped aligns to *distractor*); first line of each, every detail is in `results.json`:", ""]
+        lines += [f"- {str(e).splitlines()[0][:300]}" for e in results["errors"]] + [""]
     if results.get("timing"):
         lines += ["## Time per stage (s)", "", "| stage | seconds |", "|---|---|"]
         lines += [f"| {k} | {v:.1f} |" for k, v in results["timing"].items()] + [""]

@@ -468,6 +468,10 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
             aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
                                                  r["metrics"])
             results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
+        marker = "; LM answers completed by default: "
+        fallback = next((r["note"].split(marker, 1)[1] for r in d.values() if marker in r["note"]), None)
+        if fallback:
+            errors.append(f"{spec.id}/{kname}: LM answers completed by default: {fallback}")
     oracle = oracle_alignment(spec)
 
     # ---- RQ1
