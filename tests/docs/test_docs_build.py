@@ -40,7 +40,9 @@ def test_strict_build_writes_every_nav_page(site):
     assert "concepts.md" in listed and "plugins/checklist.md" in listed
     for page in listed:
         assert (DOCS / page).is_file(), f"nav names {page}, which does not exist"
-        html = site / ("index.html" if page == "index.md" else page.removesuffix(".md") + "/index.html")
+        stem = page.removesuffix(".md")
+        html = site / (stem.removesuffix("index") + "index.html" if stem.split("/")[-1] == "index"
+                       else stem + "/index.html")
         assert html.is_file(), f"{page} was not built"
 
 
