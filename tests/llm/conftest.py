@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
 import time
@@ -11,6 +10,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from redis_server import free_port, stop_process  # this directory's helpers (tests/llm is on sys.path)
 
 
 @pytest.fixture(scope="session")
@@ -45,16 +45,10 @@ def cache_root(tmp_path, monkeypatch, embedded_gguf) -> Path:
     return root
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="session")
 def llama_server(embedded_gguf, tmp_path_factory):
     """``python -m llama_cpp.server`` on the embedded GGUF at 127.0.0.1:<free port>; yields the ``/v1`` URL."""
-    port = _free_port()
+    port = free_port()
     log = tmp_path_factory.mktemp("llama-server") / "server.log"
     with open(log, "wb") as out:
         proc = subprocess.Popen(
@@ -78,12 +72,7 @@ def llama_server(embedded_gguf, tmp_path_factory):
             time.sleep(0.5)
         yield url
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        stop_process(proc, timeout=20)
 
 
 @pytest.fixture

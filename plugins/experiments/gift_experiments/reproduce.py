@@ -272,7 +272,8 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
                  thresholds: Sequence[str]) -> dict[str, dict]:
     """Run one kernel once on the intent's test objects; per threshold: the alignment and its metrics.
 
-    Returns ``{threshold: {"cut", "note", "mapping", "scores", "metrics": {subset: {...}}}}``.
+    Returns ``{threshold: {"cut", "note", "fallbacks", "mapping", "scores", "metrics": {subset: {...}}}}``;
+    ``fallbacks`` lists the kernel's LM answers that were completed by default (see ``MappingKernel``).
     """
     from gift_kernels.alignment import score_alignment
     from gift_kernels.evaluation import REPORT_SUBSETS, _members, subset_metrics
@@ -288,10 +289,9 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
     out = {}
     for th in thresholds:
         cut, note = scores.threshold(th, labels)
-        if fallbacks:
-            note += "; LM answers completed by default: " + "; ".join(fallbacks)
         al = scores.alignment(cut)
-        out[th] = {"cut": cut, "note": note, "mapping": dict(al.mapping), "scores": dict(al.scores),
+        out[th] = {"cut": cut, "note": note, "fallbacks": fallbacks, "mapping": dict(al.mapping),
+                   "scores": dict(al.scores),
                    "metrics": {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)], cut)
                                for sub in REPORT_SUBSETS if _members(spec, sub).any()}}
     return out
@@ -468,10 +468,9 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
             aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
                                                  r["metrics"])
             results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
-        marker = "; LM answers completed by default: "
-        fallback = next((r["note"].split(marker, 1)[1] for r in d.values() if marker in r["note"]), None)
-        if fallback:
-            errors.append(f"{spec.id}/{kname}: LM answers completed by default: {fallback}")
+        fallbacks = next(iter(d.values()), {}).get("fallbacks")  # the same for every threshold
+        if fallbacks:
+            errors.append(f"{spec.id}/{kname}: LM answers completed by default: {'; '.join(fallbacks)}")
     oracle = oracle_alignment(spec)
 
     # ---- RQ1

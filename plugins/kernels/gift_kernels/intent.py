@@ -184,7 +184,7 @@ class LMContrastiveIntentEstimator(IntentEstimator):
 
     def semantic_axes(self, motivations: Sequence[Motivation], objects: Sequence[str]) -> list[SemanticAxis]:
         """Call 2: yes/no questions grouping ``objects`` under the motivations (names validated)."""
-        from gift_llm.structured import ask_dict, extract_dict
+        from gift_llm.structured import ask_dict, last_dict
 
         if not objects:
             return []
@@ -197,9 +197,10 @@ class LMContrastiveIntentEstimator(IntentEstimator):
         except LMAnswerError as e:
             # the axes refine the intent: keep the last answer's axes without the names that do not exist;
             # with none left, the intent keeps Call 1's similarities (see estimate)
+            partial = last_dict(e)
             try:
-                kept = parse_axes(extract_dict(e.raw), objects, strict=False)
-            except (LMAnswerError, ValueError):
+                kept = parse_axes(partial, objects, strict=False) if partial is not None else []
+            except ValidationError:  # no 'axes' key
                 kept = []
             what = (f"kept {len(kept)} axes without the unknown names" if kept
                     else "no valid semantic axes, keeping Call 1's similarities")

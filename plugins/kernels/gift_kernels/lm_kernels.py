@@ -83,19 +83,15 @@ def _valid_part(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[
     return out, unknown_targets
 
 
-def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str],
-                  strict: bool = True) -> dict[str, str]:
+def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]) -> dict[str, str]:
     """Validate a Call-3 answer: every test object mapped, targets only training objects or distractor.
 
-    Names are matched case- and whitespace-insensitively. ``strict``: raises :class:`ValidationError` (a
-    ValueError) naming what is missing or unknown (``ask_dict`` turns that into a repair request); else
-    an unmapped object or an unknown target becomes ``distractor`` (aligned to nothing).
+    Names are matched case- and whitespace-insensitively. Raises :class:`ValidationError` (a ValueError) naming what is
+    missing or unknown (``ask_dict`` turns that into a repair request).
     """
     out, unknown_targets = _valid_part(answer, test, train)
     problems = []
     missing = [t for t in test if t not in out]
-    if not strict:
-        return {t: out.get(t, DISTRACTOR) for t in test}
     if unknown_targets:
         problems.append(f"unknown targets {unknown_targets}; allowed: {list(train)} or {DISTRACTOR!r}")
     if missing:
@@ -151,7 +147,7 @@ class MappingKernel(SimilarityKernel):
         return self._lm
 
     def _sample(self, test: list[str], train: list[str], intent: Intent | None, k: int) -> dict[str, str]:
-        from gift_llm.structured import ask_dict, extract_dict
+        from gift_llm.structured import ask_dict, last_dict
 
         rng = np.random.default_rng(self.seed * 1000 + k)
         t_order = [test[i] for i in rng.permutation(len(test))]
@@ -165,18 +161,16 @@ class MappingKernel(SimilarityKernel):
             # still incomplete after the repairs: keep the valid part of the last answer; an object it
             # leaves unmapped (or maps to an unknown name) aligns to nothing, i.e. distractor. An answer
             # without any dictionary is not a mapping at all: that error stands.
-            try:
-                partial = extract_dict(e.raw)
-            except (LMAnswerError, ValueError):
-                raise e from None
-            mapping = parse_mapping(partial, test, train, strict=False)
-            n_default = len(test) - len(_valid_part(partial, test, train)[0])
-            note = (f"sample {k}: {n_default} of {len(test)} objects defaulted to {DISTRACTOR!r} after "
-                    f"{self.max_repairs} repairs")
+            partial = last_dict(e)
+            if partial is None:
+                raise
+            valid, _ = _valid_part(partial, test, train)
+            note = (f"sample {k}: {len(test) - len(valid)} of {len(test)} objects defaulted to {DISTRACTOR!r} "
+                    f"after {self.max_repairs} repairs")
             self.fallbacks.append(note)
             warnings.warn(f"{self.name} kernel: {note} ({str(e).splitlines()[0][:300]})", RuntimeWarning,
                           stacklevel=2)
-            return mapping
+            return {t: valid.get(t, DISTRACTOR) for t in test}
         return parse_mapping(answer, test, train)
 
     def votes(self, test: Sequence[ObjectSpec | str], train: Sequence[ObjectSpec | str],

@@ -98,3 +98,14 @@ def ask_dict(lm: LMBackend, messages: Sequence[Message] | str, *,
         chat += [Message("assistant", raw), Message("user", REPAIR_PROMPT.format(problem=problem))]
     raise LMAnswerError(f"{lm.identity()} gave no valid dictionary after {max_repairs} repair request(s): "
                         + " | ".join(problems), raw)
+
+
+def last_dict(error: LMAnswerError) -> dict | None:
+    """The last dictionary in the raw answer of a failed :func:`ask_dict` (``None`` if it has none).
+
+    For callers that can use the valid part of an answer that stayed invalid after the repairs.
+    """
+    try:
+        return extract_dict(error.raw)
+    except (LMAnswerError, ValueError):
+        return None
