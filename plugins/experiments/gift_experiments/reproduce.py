@@ -275,25 +275,18 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
     Returns ``{threshold: {"cut", "note", "fallbacks", "mapping", "scores", "metrics": {subset: {...}}}}``;
     ``fallbacks`` lists the kernel's LM answers that were completed by default (see ``MappingKernel``).
     """
-    from gift_kernels.alignment import score_alignment
-    from gift_kernels.evaluation import REPORT_SUBSETS, _members, subset_metrics
+    from gift_kernels.evaluation import score_intent
 
     kernel = comp.kernel(kernel_name)
     n_fallbacks = len(getattr(kernel, "fallbacks", ()))
-    scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
-                             intent if kernel.uses_intent else None, relevant_train=spec.relevant_train,
-                             need=tuple(thresholds))
-    labels = {t.object: t.relevant for t in spec.test}
-    y = np.array([t.relevant for t in spec.test], dtype=bool)
+    scores, cuts, metrics = score_intent(kernel, suite, spec, intent if kernel.uses_intent else None, thresholds)
     fallbacks = list(getattr(kernel, "fallbacks", ()))[n_fallbacks:]  # LM answers completed by default
     out = {}
     for th in thresholds:
-        cut, note = scores.threshold(th, labels)
+        cut, note = cuts[th]
         al = scores.alignment(cut)
         out[th] = {"cut": cut, "note": note, "fallbacks": fallbacks, "mapping": dict(al.mapping),
-                   "scores": dict(al.scores),
-                   "metrics": {sub: subset_metrics(scores.decision[_members(spec, sub)], y[_members(spec, sub)], cut)
-                               for sub in REPORT_SUBSETS if _members(spec, sub).any()}}
+                   "scores": dict(al.scores), "metrics": metrics[th]}
     return out
 
 
