@@ -16,7 +16,7 @@ import pytest
 import gift
 from gift.core.data import DISTRACTOR, Completion, Intent, ObjectSpec
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
-from gift.core.interfaces import LMBackend
+from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift.core.suite import load_suite
 from gift_kernels import prompts
 from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_mapping
@@ -144,7 +144,7 @@ def _probs_by_name(table):
 def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
              "toothbrush": 0.4, "apple": 0.05}
-    lm = ScriptedLM(probs=_probs_by_name(table))
+    lm = ScriptedLM(answer=lambda m, s: "Art supplies.", probs=_probs_by_name(table))
     k = GiftProbKernel(lm=lm, combine="none")
     lo = k.log_odds(TEST, ART)
     assert np.allclose(lo, [np.log(0.7 / 0.3), np.log(0.4 / 0.6), np.log(0.05 / 0.95)])
@@ -157,9 +157,14 @@ def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     assert np.allclose(k.loo_relevance(TRAIN, ART, ("paintbrush", "sketchbook")), [0.9, 0.8, 0.2, 0.1])
     n_calls = len(lm.calls)
     k.relevance(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
-    assert len(lm.calls) == n_calls  # each question is asked once per kernel
-    assert all(m[0][0].content == prompts.RELEVANCE_SYSTEM for m in lm.calls)
-    assert "pack art supplies" in lm.calls[0][0][1].content and "(sticks of colored wax)" in lm.calls[0][0][1].content
+    assert len(lm.calls) == n_calls == k.calls == 1 + len(TEST) + len(TRAIN)  # each question asked once
+    # first the category, once per goal (greedy, few-shot), then one yes/no question per object
+    first, questions = lm.calls[0], lm.calls[1:]
+    assert first[0][0].content == prompts.CATEGORY_SYSTEM and first[2] == 0.0
+    assert first[0][-1].content.startswith("Goal: pack art supplies.") and k.categories == {
+        "pack art supplies": "Art supplies"}
+    assert all(m[0][0].content == prompts.RELEVANCE_SYSTEM for m in questions)
+    assert questions[0][0][1].content.startswith("Is a crayons (sticks of colored wax) one of the Art supplies?")
 
 
 def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
@@ -168,9 +173,10 @@ def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
     def probs(text):
         return {"yes": 0.9, "no": 0.1} if text.startswith("is it used to make art?") else {"yes": 0.3, "no": 0.7}
 
-    k = GiftProbKernel(lm=ScriptedLM(probs=probs), combine="none", axes=True)
+    k = GiftProbKernel(lm=ScriptedLM(probs=probs), template="goal", combine="none", axes=True)
     assert np.allclose(k.log_odds(TEST[:1], intent), [np.log(9)])
-    assert np.allclose(GiftProbKernel(lm=ScriptedLM(probs=probs), combine="none").log_odds(TEST[:1], intent),
+    assert np.allclose(GiftProbKernel(lm=ScriptedLM(probs=probs), template="goal", combine="none"
+                                      ).log_odds(TEST[:1], intent),
                        [np.log(0.3 / 0.7)])
 
 
@@ -184,14 +190,73 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
-        GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5}), combine="none").similarity(
-            TEST, TRAIN, ART, relevant_train=("ghost",))
+        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=lambda t: {"yes": .5, "no": .5}),
+                       combine="none").similarity(TEST, TRAIN, ART, relevant_train=("ghost",))
 
 
 def test_goal_text_turns_motivation_sentences_into_goal_clauses():
     assert prompts.goal_text("The human prefers to keep sharp tools away from food.") == \
         "keep sharp tools away from food"
+    assert prompts.goal_text("The person wanted to store the pearl necklace in the drawer.") == \
+        "store the pearl necklace in the drawer"
+    assert prompts.goal_text("The user would like to tidy the desk") == "tidy the desk"
     assert prompts.goal_text("pack art supplies") == "pack art supplies"
+    assert prompts.goal_text("People in the room prefer quiet") == "People in the room prefer quiet"
+
+
+def test_category_answers_are_parsed_or_fall_back_to_the_goal_with_a_warning():
+    assert prompts.parse_category('"Electronics."\nThey run on power.') == "Electronics"
+    assert prompts.parse_category("Answer: the valuables") == "valuables"
+    for bad in ("", "   \n ", "these are all the objects that the goal could possibly be about here"):
+        assert prompts.parse_category(bad) is None
+    lm = ScriptedLM(answer=lambda m, s: "", probs=lambda t: {"yes": 0.6, "no": 0.4})
+    k = GiftProbKernel(lm=lm, combine="none")
+    with pytest.warns(UserWarning, match="no object category.*pack art supplies"):
+        k.log_odds(TEST[:1], ART)
+    assert 'one of the things the goal "pack art supplies" is about?' in lm.calls[-1][0][1].content
+    k.log_odds(TEST[1:], ART)  # the goal's category is asked once
+    assert sum(c[0][0].content == prompts.CATEGORY_SYSTEM for c in lm.calls) == 1
+
+
+class TableKernel(SimilarityKernel):
+    """Scripted stand-in for the MiniLM term: ``K[i, j]`` from a name -> vector table (cosines)."""
+
+    name = "table"
+
+    def __init__(self, vec):
+        self.vec = vec
+
+    def similarity(self, test, train, intent=None, relevant_train=()):
+        a = np.array([self.vec[o.name] for o in test], float)
+        b = np.array([self.vec[o.name] for o in train], float)
+        a, b = a / np.linalg.norm(a, axis=1, keepdims=True), b / np.linalg.norm(b, axis=1, keepdims=True)
+        return a @ b.T
+
+
+def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
+    # the LM term inverts the demonstrated labels (paintbrush/sketchbook low), the language term separates them
+    table = {"paintbrush": 0.1, "sketchbook": 0.2, "banana": 0.8, "coffee mug": 0.9, "crayons": 0.3,
+             "toothbrush": 0.6, "apple": 0.7}
+    vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
+           "crayons": [0.95, 0.05, 0], "toothbrush": [0.3, 0.3, 0.6], "apple": [0, 1, 0.1]}
+    rel = ("paintbrush", "sketchbook")
+
+    def kernel(weighting):
+        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=_probs_by_name(table)),
+                              weighting=weighting, language_kernel=TableKernel(vec))
+
+    k = kernel("reliability")
+    r = k.relevance(TEST, TRAIN, ART, rel)
+    assert k.last_weights == {"lm": 0.0, "language": 1.0}
+    assert r[0] > 0.5 > max(r[1:])  # crayons relevant, the brush for teeth and the fruit not
+    eq = kernel("equal")
+    eq.relevance(TEST, TRAIN, ART, rel)
+    assert eq.last_weights == {"lm": 0.5, "language": 0.5}
+    # no evidence (no irrelevant training object): the plain weights
+    k.relevance(TEST, TRAIN[:2], ART, rel)
+    assert k.last_weights == {"lm": 0.5, "language": 0.5}
+    with pytest.raises(GiftError, match="gift-prob: weighting"):
+        GiftProbKernel(weighting="auc")
 
 
 # ----------------------------------------------------------------------------- the embedded model

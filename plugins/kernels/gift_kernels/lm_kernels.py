@@ -6,13 +6,15 @@ the objects in its own shuffled order with its own seed; ``K[i, j]`` = fraction 
 object i to training object j. The mode over {training objects, distractor} is the binary decision and
 its share the agreement rate (:meth:`MappingKernel.votes`).
 
-``gift-prob`` (:class:`GiftProbKernel`): a continuous kernel from one yes/no question per object, "is
-this object something the goal is about?", built from the goal's own words and the object's
-description and read through ``choice_probabilities``. Its score is the log-odds
+``gift-prob`` (:class:`GiftProbKernel`): a continuous kernel. The LM names, once per intent, the kind of
+object the goal is about ("art supplies"), then answers one yes/no question per object, "is a <object>
+(<description>) one of the <category>?", read through ``choice_probabilities``. Its score is the log-odds
 ``log P(yes) - log P(no)``; by default it is averaged, as z-scores, with a contrastive MiniLM description
-similarity: the largest cosine to a training object that is relevant under the intent minus the largest
-cosine to one that is not (see ``docs/results/gift_prob.md`` for the variants measured and why this won). Training objects are never shown to the LM as labelled examples, so they can
-calibrate the threshold by leave-one-out.
+similarity (the largest cosine to a training object that is relevant under the intent minus the largest
+cosine to one that is not), each term weighted by how well it separates the relevant training objects
+from the others. ``docs/results/gift_prob.md`` has the variants measured and why this won. Training
+objects are never shown to the LM as labelled examples, so they can calibrate the threshold by
+leave-one-out.
 
 Matrix rule of the relevance kernels (``gift-prob``): ``K[i, j] = r_i`` for the training objects j that
 are relevant under the intent (``relevant_train`` when given, else the training objects whose own
@@ -223,25 +225,47 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 COMBINE = ("none", "language")
 EMBED_REFERENCE = ("relevant", "contrastive")
 STANDARDIZE = ("pooled", "train")
+WEIGHTING = ("reliability", "equal")
+
+
+def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
+    """How far one score separates the relevant training objects from the others: ``max(AUC - 1/2, 0)``.
+
+    ``train_scores`` ``[n_train]`` (leave-one-out), ``relevant`` ``[n_train]`` bool. ``nan`` when one
+    class is empty (no evidence either way).
+    """
+    from gift.core.metrics import roc_auc
+
+    auc = roc_auc(train_scores, relevant)
+    return float("nan") if math.isnan(auc) else max(auc - 0.5, 0.0)
 
 
 class GiftProbKernel(SimilarityKernel):
     """Continuous GIFT kernel: P(yes) that an object is what the goal is about, as log-odds.
+
+    Default recipe (``docs/results/gift_prob.md``): the LM names the kind of object the goal is about
+    (one few-shot call per intent, :meth:`category`), then answers per object "is a <object>
+    (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM description
+    similarity are z-scored and averaged, each weighted by how well it separates the relevant training
+    objects from the others (leave-one-out; ``weighting="reliability"``).
 
     Options: ``template`` (a key of :data:`gift_kernels.prompts.RELEVANCE_TEMPLATES`), ``use_descriptions``,
     ``axes`` (also ask the intent's semantic-axis questions and keep the highest log-odds per object),
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``weight`` of the language term in the average.
+    object), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
+    that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
+    weights; ``"equal"``: the plain weights).
     """
 
     name: ClassVar[str] = "gift-prob"
     uses_intent: ClassVar[bool] = True
 
-    def __init__(self, lm: LMBackend | str | None = None, template: str = "goal", use_descriptions: bool = True,
+    def __init__(self, lm: LMBackend | str | None = None, template: str = "category", use_descriptions: bool = True,
                  axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
-                 weight: float = 0.5, standardize: str = "pooled",
+                 weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  language_kernel: SimilarityKernel | None = None) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
@@ -251,13 +275,17 @@ class GiftProbKernel(SimilarityKernel):
             raise GiftError(f"gift-prob: embed_reference must be one of {EMBED_REFERENCE}, got {embed_reference!r}")
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
+        if weighting not in WEIGHTING:
+            raise GiftError(f"gift-prob: weighting must be one of {WEIGHTING}, got {weighting!r}")
         if not 0.0 <= float(weight) <= 1.0:
             raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
         self._lm_spec, self._lm = lm, None
         self.template, self.use_descriptions, self.axes = template, bool(use_descriptions), bool(axes)
         self.combine, self.embed_reference, self.weight = combine, embed_reference, float(weight)
-        self.standardize = standardize
+        self.standardize, self.weighting = standardize, weighting
         self._language = language_kernel
+        self.categories: dict[str, str] = {}  # goal -> the category phrase its questions use
+        self.last_weights: dict[str, float] = {}  # term -> weight used by the last scores() call
         self._last: tuple[tuple, np.ndarray] | None = None  # (train key, LOO train scores) of the last call
         self._memo: dict[tuple, float] = {}
         self._lock = threading.Lock()
@@ -266,7 +294,7 @@ class GiftProbKernel(SimilarityKernel):
     def __repr__(self) -> str:
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
-                f"weight={self.weight})")
+                f"weight={self.weight}, weighting={self.weighting!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -309,13 +337,35 @@ class GiftProbKernel(SimilarityKernel):
             self._memo[key] = lo
         return lo
 
+    def category(self, intent: Intent) -> str:
+        """The kind of object the intent's goal is about ("art supplies"), asked once per goal (greedy).
+
+        An answer that is not a short noun phrase falls back, with a warning, to the goal itself.
+        """
+        goal = prompts.goal_text(intent.text)
+        with self._lock:
+            if goal in self.categories:
+                return self.categories[goal]
+        answer = self.lm.complete(prompts.category_messages(goal), temperature=0.0, max_tokens=24,
+                                  stop=["\n"]).text
+        self.calls += 1
+        cat = prompts.parse_category(answer)
+        if cat is None:
+            warnings.warn(f"gift-prob: the LM named no object category for the goal {goal!r} (answer "
+                          f"{answer[:80]!r}); asking about the goal itself", stacklevel=2)
+            cat = prompts.fallback_category(goal)
+        with self._lock:
+            self.categories[goal] = cat
+        return cat
+
     def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent) -> np.ndarray:
         """``[n]`` log P(yes) − log P(no) that each object is what the goal is about (clipped to ±12)."""
         if intent is None:
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
+        category = self.category(intent) if "{category}" in prompts.RELEVANCE_TEMPLATES[self.template] else None
         out = np.empty(len(objects))
         for i, o in enumerate(objects):
-            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions))
+            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions, category))
             if self.axes:
                 for a in intent.axes:
                     s = max(s, self._ask(prompts.axis_messages(o, a.question, self.use_descriptions)))
@@ -367,7 +417,16 @@ class GiftProbKernel(SimilarityKernel):
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
         ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
-        z = (1.0 - self.weight) * _zscore(lo, ref) + self.weight * _zscore(emb, ref)
+        terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
+        w = {"lm": 1.0 - self.weight, "language": self.weight}
+        if self.weighting == "reliability":
+            sep = {t: separation_weight(v[len(test):], rel) for t, v in terms.items()}
+            scaled = {t: w[t] * sep[t] for t in terms}
+            if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
+                w = scaled
+        total = sum(w.values())
+        self.last_weights = {t: v / total for t, v in w.items()}
+        z = sum(self.last_weights[t] * terms[t] for t in terms)
         out = z[: len(test)], z[len(test):]
         self._last = (self._train_key(train, intent, relevant_train), out[1])
         return out

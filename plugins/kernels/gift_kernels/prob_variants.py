@@ -28,14 +28,22 @@ from gift.core.suite import Suite, load_suite
 
 #: name -> GiftProbKernel options. The first entry is the default of gift-prob.
 VARIANTS: dict[str, dict[str, Any]] = {
-    "lm+minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive"),
+    "category+minilm-reliable": dict(template="category", combine="language", embed_reference="contrastive",
+                                     weighting="reliability"),
+    "category": dict(template="category", combine="none"),
+    "category+minilm": dict(template="category", combine="language", embed_reference="contrastive",
+                            weighting="equal"),
+    "lm+minilm-reliable": dict(template="goal", combine="language", embed_reference="contrastive",
+                               weighting="reliability"),
+    "lm+minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive",
+                                  weighting="equal"),
     "lm": dict(template="goal", combine="none"),
-    "lm+minilm": dict(template="goal", combine="language", embed_reference="relevant"),
+    "lm+minilm": dict(template="goal", combine="language", embed_reference="relevant", weighting="equal"),
     "lm-about": dict(template="about", combine="none"),
     "lm-name": dict(template="goal-name", combine="none"),
     "lm+minilm-trainstats": dict(template="goal", combine="language", embed_reference="relevant",
-                                 standardize="train"),
-    "lm-about+minilm": dict(template="about", combine="language"),
+                                 standardize="train", weighting="equal"),
+    "lm-about+minilm": dict(template="about", combine="language", weighting="equal"),
     "minilm": dict(template="goal", combine="language", embed_reference="relevant", weight=1.0),
     "minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive", weight=1.0),
 }
@@ -44,6 +52,7 @@ VARIANTS: dict[str, dict[str, Any]] = {
 def evaluate_variant(kernel: Any, suite: Suite, intents: Mapping[str, Intent] | None = None) -> dict[str, Any]:
     """AUC / F1 of one relevance kernel on every intent of ``suite`` (ground-truth intents by default)."""
     from gift_kernels.alignment import best_separating_cut
+    from gift_kernels.prompts import goal_text
 
     per_intent, preds, truth = {}, [], []
     for spec in suite.intents:
@@ -56,7 +65,8 @@ def evaluate_variant(kernel: Any, suite: Suite, intents: Mapping[str, Intent] | 
         pred = r_test >= cut
         m = binary_metrics(pred, labels)
         per_intent[spec.id] = {"auc": roc_auc(r_test, labels), "f1": m.f1, "cut": cut,
-                               "fp": m.fp, "fn": m.fn,
+                               "fp": m.fp, "fn": m.fn, "weights": dict(getattr(kernel, "last_weights", {})),
+                               "category": getattr(kernel, "categories", {}).get(goal_text(intent.text)),
                                "scores": {o: round(float(s), 3) for o, s in zip(spec.test_objects, r_test)}}
         preds += list(pred)
         truth += list(labels)

@@ -13,6 +13,7 @@ Each builder returns a tuple of :class:`gift.core.data.Message`.
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Mapping, Sequence
 
 from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
@@ -113,9 +114,12 @@ def mapping_messages(test: Sequence[str], train: Sequence[str], intent: Intent |
 
 RELEVANCE_SYSTEM = "You answer questions about everyday objects with a single word: yes or no."
 
-#: Question templates of gift-prob; ``{goal}``, ``{name}``, ``{desc}`` (" (description)" or "").
+#: Question templates of gift-prob; ``{goal}``, ``{name}``, ``{desc}`` (" (description)" or ""),
+#: ``{category}`` (the kind of object the goal is about, from :func:`category_messages`).
 RELEVANCE_TEMPLATES: dict[str, str] = {
-    # The goal's own words and the object's description (the winner of the held-out probe).
+    # Is the object an instance of the goal's object category (the default: see docs/results/gift_prob.md).
+    "category": "Is a {name}{desc} one of the {category}? Answer yes or no.",
+    # The goal's own words and the object's description (the winner of the first held-out probe).
     "goal": "Goal: {goal}.\nIs a {name}{desc} one of the things this goal is about? Answer yes or no.",
     # The same, phrased as "does the goal concern it".
     "about": "Goal: {goal}.\nDoes this goal concern a {name}{desc}? Answer yes or no.",
@@ -126,21 +130,66 @@ RELEVANCE_TEMPLATES: dict[str, str] = {
 AXIS_TEMPLATE = "{question}\nThe object: a {name}{desc}. Answer yes or no."
 
 
+#: A leading "The human prefers to" / "The person wanted to" / "The user would like to" of a motivation.
+_GOAL_LEAD = re.compile(r"^(the\s+)?(human|person|user|people)\s+(would\s+(rather|like\s+to|prefer\s+to)\s+|"
+                        r"(prefers|preferred|prefer|wants|wanted|want|likes|liked|tried|tries|intended|intends)"
+                        r"\s+to\s+)", re.IGNORECASE)
+
+
 def goal_text(text: str) -> str:
-    """An intent text as a goal clause: strip a trailing period and a leading "The human prefers to"."""
+    """An intent text as a goal clause: strip a trailing period and a lead such as "The human prefers to"."""
     t = text.strip().rstrip(".")
-    for lead in ("the human prefers to ", "the person prefers to ", "the human wants to ", "the person wants to "):
-        if t.lower().startswith(lead):
-            t = t[len(lead):]
-            break
-    return t
+    m = _GOAL_LEAD.match(t)
+    return t[m.end():].strip() if m else t
 
 
-def relevance_messages(obj: ObjectSpec, goal: str, template: str = "goal",
-                       use_description: bool = True) -> tuple[Message, ...]:
-    """One yes/no question: is ``obj`` something the goal is about?"""
+# ----------------------------------------------------------------------------- goal category (gift-prob)
+
+CATEGORY_SYSTEM = "You name the kind of object a household goal is about, as a short plural noun phrase."
+
+#: Worked examples shown before the goal (generic household goals, none from a benchmark suite). They
+#: teach the small model to keep the goal's own qualifiers ("gardening tools", not "tools") and, when a
+#: goal names two kinds of object, to name the kind the goal acts on or protects.
+CATEGORY_EXAMPLES: tuple[tuple[str, str], ...] = (
+    ("put the gardening tools back in the shed", "gardening tools"),
+    ("keep the candle away from flammable things", "flammable things"),
+    ("wrap the fragile things before the move", "fragile things"),
+    ("hand me something to write with", "things to write with"),
+)
+
+
+def category_messages(goal: str) -> tuple[Message, ...]:
+    """Ask which kind of object ``goal`` is about (few-shot, answered with a plural noun phrase)."""
+    msgs = [Message("system", CATEGORY_SYSTEM)]
+    for g, c in CATEGORY_EXAMPLES:
+        msgs += [Message("user", f"Goal: {g}.\nWhich objects is this goal about?"), Message("assistant", c)]
+    msgs.append(Message("user", f"Goal: {goal_text(goal)}.\nWhich objects is this goal about?"))
+    return tuple(msgs)
+
+
+def parse_category(answer: str, max_words: int = 8) -> str | None:
+    """The noun phrase of a category answer (first line, quotes, a leading "the" and end punctuation
+    removed), or ``None`` when there is none or it is longer than ``max_words`` words."""
+    line = next((ln for ln in answer.strip().splitlines() if ln.strip()), "").strip()
+    line = re.sub(r"^(answer|category|objects)\s*:\s*", "", line, flags=re.IGNORECASE)
+    line = line.strip(" \t\"'`*.,;:!").strip()
+    line = re.sub(r"^the\s+", "", line, flags=re.IGNORECASE)
+    if not line or len(line.split()) > max_words:
+        return None
+    return line
+
+
+def fallback_category(goal: str) -> str:
+    """The category phrase used when the LM gives none: the goal itself."""
+    return f'things the goal "{goal_text(goal)}" is about'
+
+
+def relevance_messages(obj: ObjectSpec, goal: str, template: str = "category",
+                       use_description: bool = True, category: str | None = None) -> tuple[Message, ...]:
+    """One yes/no question: is ``obj`` something the goal is about (one of its ``category``)?"""
     desc = f" ({obj.description.strip()})" if use_description and obj.description.strip() else ""
-    body = RELEVANCE_TEMPLATES[template].format(goal=goal_text(goal), name=obj.name, desc=desc)
+    body = RELEVANCE_TEMPLATES[template].format(goal=goal_text(goal), name=obj.name, desc=desc,
+                                                category=category or fallback_category(goal))
     return (Message("system", RELEVANCE_SYSTEM), Message("user", body))
 
 
