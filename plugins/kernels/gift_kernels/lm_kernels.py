@@ -226,6 +226,7 @@ COMBINE = ("none", "language")
 EMBED_REFERENCE = ("relevant", "contrastive")
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
+CATEGORY_FROM = ("goal+objects", "goal")
 
 
 def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
@@ -244,8 +245,9 @@ class GiftProbKernel(SimilarityKernel):
     """Continuous GIFT kernel: P(yes) that an object is what the goal is about, as log-odds.
 
     Default recipe (``docs/results/gift_prob.md``): the LM names the kind of object the goal is about
-    (one few-shot call per intent, :meth:`category`), then answers per object "is a <object>
-    (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM description
+    from the goal and the training objects the demonstrations treat as part of it (one few-shot call per
+    intent, plus one per training object with that object left out; :meth:`category`), then answers per
+    object "is a <object> (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM description
     similarity are z-scored and averaged, each weighted by how well it separates the relevant training
     objects from the others (leave-one-out; ``weighting="reliability"``).
 
@@ -257,7 +259,9 @@ class GiftProbKernel(SimilarityKernel):
     object), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
-    weights; ``"equal"``: the plain weights).
+    weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
+    the goal and the demonstrated training objects when ``relevant_train`` is given; ``"goal"``: from the
+    goal alone).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -266,7 +270,7 @@ class GiftProbKernel(SimilarityKernel):
     def __init__(self, lm: LMBackend | str | None = None, template: str = "category", use_descriptions: bool = True,
                  axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
-                 language_kernel: SimilarityKernel | None = None) -> None:
+                 category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -277,14 +281,17 @@ class GiftProbKernel(SimilarityKernel):
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
             raise GiftError(f"gift-prob: weighting must be one of {WEIGHTING}, got {weighting!r}")
+        if category_from not in CATEGORY_FROM:
+            raise GiftError(f"gift-prob: category_from must be one of {CATEGORY_FROM}, got {category_from!r}")
         if not 0.0 <= float(weight) <= 1.0:
             raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
         self._lm_spec, self._lm = lm, None
         self.template, self.use_descriptions, self.axes = template, bool(use_descriptions), bool(axes)
         self.combine, self.embed_reference, self.weight = combine, embed_reference, float(weight)
-        self.standardize, self.weighting = standardize, weighting
+        self.standardize, self.weighting, self.category_from = standardize, weighting, category_from
+        self._category_memo: dict[tuple, str] = {}
         self._language = language_kernel
-        self.categories: dict[str, str] = {}  # goal -> the category phrase its questions use
+        self.categories: dict[str, str] = {}  # goal -> the category its test objects were last asked about
         self.last_weights: dict[str, float] = {}  # term -> weight used by the last scores() call
         self._last: tuple[tuple, np.ndarray] | None = None  # (train key, LOO train scores) of the last call
         self._memo: dict[tuple, float] = {}
@@ -294,7 +301,7 @@ class GiftProbKernel(SimilarityKernel):
     def __repr__(self) -> str:
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
-                f"weight={self.weight}, weighting={self.weighting!r})")
+                f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -337,17 +344,23 @@ class GiftProbKernel(SimilarityKernel):
             self._memo[key] = lo
         return lo
 
-    def category(self, intent: Intent) -> str:
-        """The kind of object the intent's goal is about ("art supplies"), asked once per goal (greedy).
+    def category(self, intent: Intent, handled: Sequence[str] = (), left_alone: Sequence[str] = ()) -> str:
+        """The kind of object the intent's goal is about ("art supplies"), asked once per question (greedy).
 
-        An answer that is not a short noun phrase falls back, with a warning, to the goal itself.
+        With ``category_from="goal+objects"`` and at least one ``handled`` training object (one the
+        demonstrations treat as part of the goal; ``left_alone``: the others) the LM names the kind
+        from the goal and those objects; else from the goal alone. An answer that is not a short noun
+        phrase falls back, with a warning, to the goal itself.
         """
         goal = prompts.goal_text(intent.text)
+        use_objects = self.category_from == "goal+objects" and len(handled) > 0
+        key = (goal, tuple(handled), tuple(left_alone)) if use_objects else (goal,)
         with self._lock:
-            if goal in self.categories:
-                return self.categories[goal]
-        answer = self.lm.complete(prompts.category_messages(goal), temperature=0.0, max_tokens=24,
-                                  stop=["\n"]).text
+            if key in self._category_memo:
+                return self._category_memo[key]
+        msgs = (prompts.category_from_objects_messages(goal, handled, left_alone) if use_objects
+                else prompts.category_messages(goal))
+        answer = self.lm.complete(msgs, temperature=0.0, max_tokens=24, stop=["\n"]).text
         self.calls += 1
         cat = prompts.parse_category(answer)
         if cat is None:
@@ -355,22 +368,53 @@ class GiftProbKernel(SimilarityKernel):
                           f"{answer[:80]!r}); asking about the goal itself", stacklevel=2)
             cat = prompts.fallback_category(goal)
         with self._lock:
-            self.categories[goal] = cat
+            self._category_memo[key] = cat
         return cat
 
-    def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent) -> np.ndarray:
-        """``[n]`` log P(yes) − log P(no) that each object is what the goal is about (clipped to ±12)."""
+    def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent,
+                 categories: Sequence[str] | None = None) -> np.ndarray:
+        """``[n]`` log P(yes) − log P(no) that each object is what the goal is about (clipped to ±12).
+
+        ``categories`` (``[n]``, for the ``category`` template): the category each object is asked
+        about; default: :meth:`category` of the goal alone for every object.
+        """
         if intent is None:
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
-        category = self.category(intent) if "{category}" in prompts.RELEVANCE_TEMPLATES[self.template] else None
+        uses_category = "{category}" in prompts.RELEVANCE_TEMPLATES[self.template]
+        if categories is None:
+            cat = self.category(intent) if uses_category else None
+            if cat is not None:
+                with self._lock:
+                    self.categories[prompts.goal_text(intent.text)] = cat
+            categories = [cat] * len(objects)
+        elif len(categories) != len(objects):
+            raise GiftError(f"gift-prob: {len(categories)} categories for {len(objects)} objects")
         out = np.empty(len(objects))
         for i, o in enumerate(objects):
-            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions, category))
+            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions,
+                                                     categories[i]))
             if self.axes:
                 for a in intent.axes:
                     s = max(s, self._ask(prompts.axis_messages(o, a.question, self.use_descriptions)))
             out[i] = s
         return out
+
+    def _categories(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
+                    relevant_train: Sequence[str]) -> list[str] | None:
+        """Per object of ``test + train``, the category it is asked about; a training object's is named
+        without it (leave-one-out), so its score can calibrate a threshold. ``None``: the goal's alone."""
+        if (self.category_from != "goal+objects" or not relevant_train
+                or "{category}" not in prompts.RELEVANCE_TEMPLATES[self.template]):
+            return None
+        rel = set(relevant_train)
+        handled = [o.name for o in train if o.name in rel]
+        alone = [o.name for o in train if o.name not in rel]
+        full = self.category(intent, handled, alone)
+        with self._lock:
+            self.categories[prompts.goal_text(intent.text)] = full
+        loo = [self.category(intent, [n for n in handled if n != o.name], [n for n in alone if n != o.name])
+               for o in train]
+        return [full] * len(test) + loo
 
     def _relevant_mask(self, train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str],
                        train_lo: np.ndarray) -> np.ndarray:
@@ -409,7 +453,11 @@ class GiftProbKernel(SimilarityKernel):
         on the same scale as the test objects, so they can calibrate a threshold.
         """
         test, train = list(test), list(train)
-        lo = self.log_odds(test + train, intent)
+        if intent is None:
+            raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
+        if relevant_train:
+            self._relevant_mask(train, intent, relevant_train, np.zeros(len(train)))  # unknown names fail first
+        lo = self.log_odds(test + train, intent, self._categories(test, train, intent, relevant_train))
         lo_test, lo_train = lo[: len(test)], lo[len(test):]
         if self.combine == "none":
             return lo_test, lo_train

@@ -3,6 +3,7 @@
 Usage::
 
     python -m gift_kernels.prob_variants --suite gift-paper [--lm NAME] [--variants a,b] [--json]
+        [--intents-from runs/jaco/results.json]   # the intents a reproduce run inferred
 
 Each variant is a set of :class:`gift_kernels.lm_kernels.GiftProbKernel` options. Per intent the kernel
 scores the test objects and, leave-one-out, the training objects in one call; the threshold is the cut
@@ -18,21 +19,27 @@ import json
 import sys
 import time
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gift.core.data import Intent
+from gift.core.errors import GiftError
 from gift.core.metrics import binary_metrics, roc_auc
 from gift.core.suite import Suite, load_suite
 
 #: name -> GiftProbKernel options. The first entry is the default of gift-prob.
 VARIANTS: dict[str, dict[str, Any]] = {
-    "category+minilm-reliable": dict(template="category", combine="language", embed_reference="contrastive",
-                                     weighting="reliability"),
-    "category": dict(template="category", combine="none"),
-    "category+minilm": dict(template="category", combine="language", embed_reference="contrastive",
-                            weighting="equal"),
+    "objects-category+minilm-reliable": dict(template="category", category_from="goal+objects",
+                                             combine="language", embed_reference="contrastive",
+                                             weighting="reliability"),
+    "objects-category": dict(template="category", category_from="goal+objects", combine="none"),
+    "category+minilm-reliable": dict(template="category", category_from="goal", combine="language",
+                                     embed_reference="contrastive", weighting="reliability"),
+    "category": dict(template="category", category_from="goal", combine="none"),
+    "category+minilm": dict(template="category", category_from="goal", combine="language",
+                            embed_reference="contrastive", weighting="equal"),
     "lm+minilm-reliable": dict(template="goal", combine="language", embed_reference="contrastive",
                                weighting="reliability"),
     "lm+minilm-contrastive": dict(template="goal", combine="language", embed_reference="contrastive",
@@ -92,6 +99,19 @@ def run(suite: str, variants: Sequence[str], lm: Any = None, intents: Mapping[st
     return out
 
 
+def load_intents(results_json: str | Path) -> dict[str, Intent]:
+    """intent id -> the intent a `gift reproduce` run conditioned its kernels on (its ``results.json``)."""
+    path = Path(results_json)
+    try:
+        data = json.loads(path.read_text())
+        raw = data["intents"]
+        return {k: Intent(text=v["text"], source=v.get("source", "inferred")) for k, v in raw.items()}
+    except (OSError, json.JSONDecodeError) as e:
+        raise GiftError(f"--intents-from {path}: cannot read a results.json ({e})") from e
+    except (KeyError, TypeError, AttributeError) as e:
+        raise GiftError(f"--intents-from {path}: no 'intents' table of {{id: {{text: ...}}}} in it ({e!r})") from e
+
+
 def format_table(results: Mapping[str, Mapping[str, Any]]) -> str:
     lines = ["| variant | AUC (mean per intent) | F1 (train-calibrated) | precision | recall | FP | FN |",
              "|---|---|---|---|---|---|---|"]
@@ -106,13 +126,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--suite", default="gift-paper")
     p.add_argument("--lm", default=None, help="LM backend name (default: the embedded model)")
     p.add_argument("--variants", default=",".join(VARIANTS), help=f"comma-separated, from {list(VARIANTS)}")
+    p.add_argument("--intents-from", default=None, metavar="RESULTS_JSON",
+                   help="use the inferred intents of a `gift reproduce` run (its results.json) instead of "
+                        "the suite's ground-truth texts")
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     names = [v.strip() for v in args.variants.split(",") if v.strip()]
     bad = [v for v in names if v not in VARIANTS]
     if bad:
         p.error(f"unknown variants {bad}; known: {list(VARIANTS)}")
-    res = run(args.suite, names, lm=args.lm)
+    intents = load_intents(args.intents_from) if args.intents_from else None
+    res = run(args.suite, names, lm=args.lm, intents=intents)
     print(json.dumps(res, indent=1) if args.json else format_table(res))
     return 0
 

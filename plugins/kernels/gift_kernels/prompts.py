@@ -167,6 +167,40 @@ def category_messages(goal: str) -> tuple[Message, ...]:
     return tuple(msgs)
 
 
+#: Worked examples for naming the category from the goal *and* the demonstrated objects (household
+#: goals from neither suite). The second and third teach the model to generalise from a goal that names
+#: one object, or names none of the objects it is about, to the kind the handled objects share.
+CATEGORY_EXAMPLES_WITH_OBJECTS: tuple[tuple[str, tuple[str, ...], tuple[str, ...], str], ...] = (
+    ("put the gardening tools back in the shed", ("trowel", "pruning shears"), ("umbrella", "bicycle pump"),
+     "gardening tools"),
+    ("The person wanted to put the ski goggles in the bag", ("ski goggles", "ski gloves"),
+     ("sunglasses", "tennis racket"), "ski gear"),
+    ("carry the tray quickly to the table", ("candle", "paper lantern"), ("ceramic mug", "steel pot"),
+     "flammable things"),
+    ("wrap the fragile things before the move", ("wine glass", "porcelain plate"),
+     ("wool blanket", "plastic bucket"), "fragile things"),
+)
+
+
+def _objects_question(goal: str, handled: Sequence[str], left_alone: Sequence[str]) -> str:
+    return (f"Goal: {goal_text(goal)}.\nObjects the person handled as part of this goal: {', '.join(handled)}.\n"
+            f"Objects they left alone: {', '.join(left_alone) or 'none'}.\n"
+            f"Which kind of objects is this goal about?")
+
+
+def category_from_objects_messages(goal: str, handled: Sequence[str],
+                                   left_alone: Sequence[str]) -> tuple[Message, ...]:
+    """Ask which kind of object ``goal`` is about, given the training objects the demonstrations
+    treated as part of it (``handled``, at least one) and the others (few-shot, a plural noun phrase)."""
+    if not handled:
+        raise ValueError("category_from_objects_messages needs at least one handled object")
+    msgs = [Message("system", CATEGORY_SYSTEM)]
+    for g, h, a, c in CATEGORY_EXAMPLES_WITH_OBJECTS:
+        msgs += [Message("user", _objects_question(g, h, a)), Message("assistant", c)]
+    msgs.append(Message("user", _objects_question(goal, handled, left_alone)))
+    return tuple(msgs)
+
+
 def parse_category(answer: str, max_words: int = 8) -> str | None:
     """The noun phrase of a category answer (first line, quotes, a leading "the" and end punctuation
     removed), or ``None`` when there is none or it is longer than ``max_words`` words."""
