@@ -385,6 +385,22 @@ class Intent:
             seen.update(dict.fromkeys(m.features))
         return tuple(seen)
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``{text, source, motivations: [{text, features}], axes: [{question, objects}]}``."""
+        return {"text": self.text, "source": self.source,
+                "motivations": [{"text": m.text, "features": list(m.features)} for m in self.motivations],
+                "axes": [{"question": a.question, "objects": list(a.objects)} for a in self.axes]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Intent":
+        """Inverse of :meth:`to_dict`; ``motivations``, ``axes`` and ``source`` may be left out."""
+        try:
+            return cls(d["text"], [Motivation(m["text"], m.get("features", ())) for m in d.get("motivations", ())],
+                       [SemanticAxis(a["question"], a.get("objects", ())) for a in d.get("axes", ())],
+                       source=d.get("source", "given"))
+        except (KeyError, TypeError, AttributeError) as e:
+            raise ValidationError(f"not an intent dict ({type(e).__name__}: {e}): {str(d)[:200]}") from None
+
 
 @attrs.frozen
 class Alignment:

@@ -27,3 +27,15 @@ def test_non_finite_floats_follow_the_mode(mode, nan, inf):
 def test_unknown_mode_is_refused():
     with pytest.raises(ValueError, match="nonfinite must be one of"):
         to_jsonable([1.0], nonfinite="drop")
+
+
+def test_an_intent_round_trips_through_json_and_a_bad_one_says_what_is_missing():
+    from gift.core.data import Intent, Motivation, SemanticAxis
+    from gift.core.errors import ValidationError
+
+    intent = Intent("keep water-sensitive items away", [Motivation("avoid the laptop", ["mug_proximity_to_laptop"])],
+                    [SemanticAxis("is it damaged by water?", ["laptop"])], source="inferred")
+    assert Intent.from_dict(json.loads(json.dumps(intent.to_dict()))) == intent
+    assert Intent.from_dict({"text": "pack art supplies"}) == Intent("pack art supplies")
+    with pytest.raises(ValidationError, match="not an intent dict.*'text'"):
+        Intent.from_dict({"motivations": []})

@@ -238,19 +238,6 @@ def infer_intent(comp: Components, spec: IntentSpec, pairs: Sequence[Demonstrati
                         objects=spec.train_objects)
 
 
-def intent_to_json(intent: Intent) -> dict:
-    return {"text": intent.text, "source": intent.source,
-            "motivations": [{"text": m.text, "features": list(m.features)} for m in intent.motivations],
-            "axes": [{"question": a.question, "objects": list(a.objects)} for a in intent.axes]}
-
-
-def intent_from_json(d: dict) -> Intent:
-    from gift.core.data import Motivation, SemanticAxis
-
-    return Intent(d["text"], [Motivation(m["text"], m["features"]) for m in d["motivations"]],
-                  [SemanticAxis(a["question"], a["objects"]) for a in d["axes"]], source=d["source"])
-
-
 def text_cosine(a: Sequence[str], b: str) -> np.ndarray:
     """MiniLM cosine of each sentence in ``a`` with ``b`` (raw cosine in [-1, 1])."""
     from gift_kernels.language import embed_texts
@@ -420,7 +407,7 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
     needs_intent = any(gift.get_manager().get("kernel", k).factory.uses_intent for k in cfg.kernels)
     if cfg.intent_source == "inferred" and (needs_intent or cfg.sanity_reps):
         def _infer():
-            main = intent_to_json(infer_intent(comp, spec, pairs, seed=0, temperature=0.0))
+            main = infer_intent(comp, spec, pairs, seed=0, temperature=0.0).to_dict()
             reps, rep_errors = [], []
             for r in progress(range(cfg.sanity_reps), f"{spec.id}: intent reps"):
                 try:  # the sanity check reads only the text: no Call 2
@@ -431,7 +418,7 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
             return {"main": main, "reps": reps, "rep_errors": rep_errors}
 
         inferred = timed("intent", lambda: cache.get_or_compute(f"intent-{spec.id}", _infer))
-        intent = intent_from_json(inferred["main"])
+        intent = Intent.from_dict(inferred["main"])
         if inferred["reps"]:
             texts = inferred["reps"]
             cos_inf = text_cosine(texts, spec.text)
@@ -445,7 +432,7 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
         from gift_kernels.evaluation import ground_truth_intent
 
         intent = ground_truth_intent(spec)
-    results["intents"][spec.id] = intent_to_json(intent)
+    results["intents"][spec.id] = intent.to_dict()
 
     # ---- alignments (once per kernel; independent of the number of trajectories)
     aligned: dict[str, dict[str, tuple[Alignment, dict]]] = {}

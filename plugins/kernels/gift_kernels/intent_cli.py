@@ -13,11 +13,10 @@ import argparse
 import json
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import attrs
 
-from gift.core.data import DemonstrationPair, FeatureSpec, FeatureTrace, Intent
+from gift.core.data import DemonstrationPair, FeatureSpec, FeatureTrace
 from gift.core.errors import GiftError, ValidationError
 
 FORMAT = 1
@@ -57,10 +56,6 @@ def load_demonstrations(path: str | Path) -> tuple[list[DemonstrationPair], str,
     return pairs, str(doc.get("task_context", "")), [str(o) for o in doc.get("objects", [])]
 
 
-def intent_as_dict(intent: Intent) -> dict[str, Any]:
-    return attrs.asdict(intent)
-
-
 def configure_infer_intent(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("demonstrations", help="JSON file of demonstration pairs (see gift_kernels.intent_cli)")
     parser.add_argument("--estimator", default="lm-contrastive", help="registered intent estimator")
@@ -79,7 +74,7 @@ def run_infer_intent(args: argparse.Namespace) -> int:
     intent = estimator.estimate(pairs, task_context=args.task_context if args.task_context is not None else context,
                                 objects=args.objects if args.objects is not None else objects)
     if args.json:
-        print(json.dumps(intent_as_dict(intent), indent=1))
+        print(json.dumps(intent.to_dict(), indent=1))
         return 0
     print(f"intent: {intent.text}")
     for k, m in enumerate(intent.motivations, 1):

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from gift.core.data import Intent
-from gift.core.errors import GiftError
+from gift.core.errors import GiftError, ValidationError
 from gift.core.metrics import binary_metrics, roc_auc
 from gift.core.suite import Suite, load_suite
 
@@ -104,11 +104,10 @@ def load_intents(results_json: str | Path) -> dict[str, Intent]:
     path = Path(results_json)
     try:
         data = json.loads(path.read_text())
-        raw = data["intents"]
-        return {k: Intent(text=v["text"], source=v.get("source", "inferred")) for k, v in raw.items()}
+        return {k: Intent.from_dict(v) for k, v in data["intents"].items()}
     except (OSError, json.JSONDecodeError) as e:
         raise GiftError(f"--intents-from {path}: cannot read a results.json ({e})") from e
-    except (KeyError, TypeError, AttributeError) as e:
+    except (KeyError, TypeError, AttributeError, ValidationError) as e:
         raise GiftError(f"--intents-from {path}: no 'intents' table of {{id: {{text: ...}}}} in it ({e!r})") from e
 
 
