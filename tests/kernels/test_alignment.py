@@ -48,7 +48,7 @@ class RelevanceKernel(TableKernel):
         super().__init__({})
         self.p, self.relevance_calls = p, 0
 
-    def similarity(self, test, train, intent=None):
+    def similarity(self, test, train, intent=None, relevant_train=()):
         return np.array([[self.p[a.name] if b.name in REL else 0.0 for b in train] for a in test])
 
     def relevance(self, test, train, intent, relevant_train):

@@ -200,6 +200,23 @@ def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects
         prompts.category_from_objects_messages("pack art supplies", [], ["banana"])
 
 
+def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_questions_each_once():
+    from gift_kernels.alignment import score_alignment
+
+    lm = ScriptedLM(answer=lambda m, s: "art supplies" if "handled" in m[-1].content else "art things",
+                    probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1,
+                                          "crayons": 0.7, "toothbrush": 0.4, "apple": 0.05}))
+    k = GiftProbKernel(lm=lm, combine="none")
+    sc = score_alignment(k, TEST, TRAIN, ART, relevant_train=("paintbrush", "sketchbook"))
+    assert np.allclose(sc.decision, [0.7, 0.4, 0.05])
+    asked = [tuple(m.content for m in c[0]) for c in lm.calls]
+    assert len(asked) == len(set(asked)) == k.calls  # no question twice
+    # no goal-only category: K, the relevance and the leave-one-out scores share one scoring pass
+    assert not any(a[-1].endswith("Which objects is this goal about?") for a in asked)
+    # 1 + 4 categories, 3 test and 4 training objects under the full category (rows of K(train, train))
+    assert len(asked) == 1 + len(TRAIN) + len(TEST) + len(TRAIN)
+
+
 def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
     intent = Intent(text="pack art supplies", axes=(gift.SemanticAxis("is it used to make art?", ("crayons",)),))
 

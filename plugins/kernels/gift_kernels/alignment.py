@@ -17,7 +17,8 @@ objects the intent makes relevant (``relevant_train``; empty = unknown).
   score is that relevance; the target is ``argmax_{j in rel} K[i, j]`` (the relevant training object
   whose role it plays) when the score reaches the threshold, else DISTRACTOR. Such a kernel should put
   p_i into the relevant columns of K, so that the paper's rule above gives the same decisions when it
-  is used without ``relevant_train``.
+  is used without ``relevant_train``, and its ``similarity()`` takes ``relevant_train=`` too (passed
+  whenever it is known), so that K and the relevance come from one scoring pass.
 
 Predicted relevant = aligned to a relevant training object = ``decision score >= threshold``.
 
@@ -223,10 +224,12 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
     # one kernel call for test and training rows together: an LM kernel then spends no extra calls on
     # the training-set thresholds (its call count stays per scene, not per threshold)
     rows = test + train if want_train else test
-    K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
+    use_relevance = bool(relevant_train) and callable(getattr(kernel, "relevance", None))
+    K_all = (kernel.similarity(rows, train, intent, relevant_train=tuple(relevant_train)) if use_relevance
+             else kernel.similarity(rows, train, intent))
+    K_all = _check_matrix(K_all, len(rows), len(train), kernel,
                           "the test objects" + (" and the training objects" if want_train else ""))
     K, Ktt = K_all[:len(test)], (K_all[len(test):] if want_train else None)
-    use_relevance = bool(relevant_train) and callable(getattr(kernel, "relevance", None))
     if use_relevance:
         decision = _check_vector(kernel.relevance(test, train, intent, tuple(relevant_train)), len(test), kernel,
                                  "the test objects")

@@ -416,8 +416,11 @@ class GiftProbKernel(SimilarityKernel):
                for o in train]
         return [full] * len(test) + loo
 
-    def _relevant_mask(self, train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str],
-                       train_lo: np.ndarray) -> np.ndarray:
+    @staticmethod
+    def _relevant_mask(train: Sequence[ObjectSpec], relevant_train: Sequence[str],
+                       train_lo: np.ndarray | None = None) -> np.ndarray:
+        """``[n_train]`` bool: the given ``relevant_train``, else the objects the LM calls relevant
+        (``train_lo > 0``, at least the best one; ``train_lo`` is needed only then)."""
         names = [o.name for o in train]
         if relevant_train:
             unknown = set(relevant_train) - set(names)
@@ -455,13 +458,13 @@ class GiftProbKernel(SimilarityKernel):
         test, train = list(test), list(train)
         if intent is None:
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
-        if relevant_train:
-            self._relevant_mask(train, intent, relevant_train, np.zeros(len(train)))  # unknown names fail first
+        rel = self._relevant_mask(train, relevant_train) if relevant_train else None  # unknown names fail first
         lo = self.log_odds(test + train, intent, self._categories(test, train, intent, relevant_train))
         lo_test, lo_train = lo[: len(test)], lo[len(test):]
         if self.combine == "none":
             return lo_test, lo_train
-        rel = self._relevant_mask(train, intent, relevant_train, lo_train)
+        if rel is None:
+            rel = self._relevant_mask(train, (), lo_train)
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
         ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
@@ -519,6 +522,6 @@ class GiftProbKernel(SimilarityKernel):
         if not test or not train:
             return np.zeros((len(test), len(train)))
         s_test, _ = self.scores(test, train, intent, relevant_train)
-        lo_train = self.log_odds(train, intent)
-        rel = self._relevant_mask(train, intent, relevant_train, lo_train)
+        rel = (self._relevant_mask(train, relevant_train) if relevant_train
+               else self._relevant_mask(train, (), self.log_odds(train, intent)))
         return np.where(rel[None, :], _sigmoid(s_test)[:, None], 0.0)
