@@ -338,7 +338,7 @@ def test_gift_prob_on_the_embedded_model_ranks_and_aligns_art_supplies(embedded_
 
 @pytest.mark.slow
 def test_gift_prob_default_on_the_embedded_model_names_each_goals_category_and_ranks_every_dev_intent(embedded_lm):
-    """The default recipe on all held-out dev intents: a category per goal, then a ranking of test objects."""
+    """The default recipe on every dev-suite intent: a category per goal, then a ranking of test objects."""
     from gift.core.metrics import roc_auc
 
     suite = load_suite(SUITE)
@@ -352,7 +352,7 @@ def test_gift_prob_default_on_the_embedded_model_names_each_goals_category_and_r
         assert sum(k.last_weights.values()) == pytest.approx(1.0) and min(k.last_weights.values()) >= 0
         aucs[spec.id] = roc_auc(r, [o.name in spec.relevant_test for o in test])
     cats = {g: c.lower() for g, c in k.categories.items()}
-    assert len(cats) == len(aucs)  # one category call per goal
+    assert len(cats) == len(aucs)  # the category each goal's test objects were asked about
     assert "electronic" in cats["keep the coffee away from electronics"]
     assert "art" in cats["pack art supplies"] and "sharp" in cats["put sharp tools away in the drawer"]
     assert all(len(c.split()) <= 6 for c in cats.values()), cats  # a short noun phrase, not a sentence
