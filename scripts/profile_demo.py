@@ -30,17 +30,19 @@ import time
 from pathlib import Path
 
 ROWS: dict[str, list[float]] = collections.defaultdict(list)
+CPU: dict[str, list[float]] = collections.defaultdict(list)  #: process CPU seconds (all threads) per row
 LM_CALLS: list[dict] = []
 
 
 def _timed(label: str, fn):
     @functools.wraps(fn)
     def wrapper(*a, **kw):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             return fn(*a, **kw)
         finally:
             ROWS[label].append(time.perf_counter() - t0)
+            CPU[label].append(time.process_time() - c0)
 
     return wrapper
 
@@ -87,22 +89,23 @@ def _instrument() -> None:
         with self._lock:
             before = llama._input_ids[: llama.n_tokens].tolist()  # noqa: SLF001
             prompt = self._prompt_tokens(messages)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = orig_complete(self, messages, **kw)
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         reused = min(_common_prefix(before, prompt), max(len(prompt) - 1, 0)) if self.reuse_prefix else 0
         LM_CALLS.append({"kind": _lm_kind(messages), "method": "complete", "prompt_tokens": out.usage.prompt_tokens,
                          "reused_tokens": reused, "answer_tokens": out.usage.completion_tokens, "seconds": dt,
-                         "json": kw.get("json_schema") is not None})
+                         "cpu_s": cpu, "threads": self.last_threads, "json": kw.get("json_schema") is not None})
         return out
 
     def choice_probabilities(self, messages, choices):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = orig_choices(self, messages, choices)
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         LM_CALLS.append({"kind": _lm_kind(messages), "method": "choice_probabilities",
                          "prompt_tokens": len(self._prompt_tokens(messages)), "reused_tokens": self.last_reused_tokens,
-                         "answer_tokens": 0, "seconds": dt, "json": False})
+                         "answer_tokens": 0, "seconds": dt, "cpu_s": cpu,
+                         "threads": self.last_threads, "json": False})
         return out
 
     llamacpp.LlamaCppLM.complete = complete
@@ -140,23 +143,25 @@ def _link_model(cache: Path) -> None:
         shutil.copy(src.with_name(src.name + ".verified.json"), dest / (src.name + ".verified.json"))
 
 
-def table(rows: dict[str, list[float]], calls: list[dict], total: float) -> str:
-    out = ["| where | calls | seconds | share of the run |", "|---|---:|---:|---:|"]
+def table(rows: dict[str, list[float]], calls: list[dict], total: float, cpu: dict[str, list[float]]) -> str:
+    out = ["| where | calls | seconds | CPU seconds | share of the run |", "|---|---:|---:|---:|---:|"]
     for label, times in sorted(rows.items(), key=lambda kv: -sum(kv[1])):
-        out.append(f"| {label} | {len(times)} | {sum(times):.1f} | {100 * sum(times) / total:.0f} % |")
+        out.append(f"| {label} | {len(times)} | {sum(times):.1f} | {sum(cpu[label]):.1f} | "
+                   f"{100 * sum(times) / total:.0f} % |")
     by_kind: dict[str, list[dict]] = collections.defaultdict(list)
     for c in calls:
         by_kind[c["kind"]].append(c)
     out += ["", "| LM call | calls | prompt tokens (sum) | of which reused from the KV cache | answer tokens (sum) "
-                "| seconds | s per call |", "|---|---:|---:|---:|---:|---:|---:|"]
+                "| seconds | CPU seconds | s per call |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for kind, cs in sorted(by_kind.items(), key=lambda kv: -sum(c["seconds"] for c in kv[1])):
         s = sum(c["seconds"] for c in cs)
         out.append(f"| {kind} | {len(cs)} | {sum(c['prompt_tokens'] for c in cs)} | "
                    f"{sum(c['reused_tokens'] for c in cs)} | {sum(c['answer_tokens'] for c in cs)} | {s:.1f} | "
-                   f"{s / len(cs):.2f} |")
+                   f"{sum(c['cpu_s'] for c in cs):.1f} | {s / len(cs):.2f} |")
     lm = sum(c["seconds"] for c in calls)
     out.append(f"| **all LM calls** | {len(calls)} | {sum(c['prompt_tokens'] for c in calls)} | "
-               f"{sum(c['reused_tokens'] for c in calls)} | {sum(c['answer_tokens'] for c in calls)} | {lm:.1f} | |")
+               f"{sum(c['reused_tokens'] for c in calls)} | {sum(c['answer_tokens'] for c in calls)} | {lm:.1f} | "
+               f"{sum(c['cpu_s'] for c in calls):.1f} | |")
     out.append(f"\nTotal wall time {total:.1f} s; LM calls {lm:.1f} s ({100 * lm / total:.0f} %).")
     return "\n".join(out)
 
@@ -192,11 +197,11 @@ def main(argv: list[str] | None = None) -> int:
         profiler.stop()
         (out / "profile.html").write_text(profiler.output_html())
         (out / "profile.txt").write_text(profiler.output_text(unicode=False, color=False, show_all=False))
-    text = table(ROWS, LM_CALLS, total)
+    text = table(ROWS, LM_CALLS, total, CPU)
     load = os.getloadavg()
     text += f" Process CPU time {cpu:.1f} s; load average at the end {load[0]:.1f} (1 min), {load[2]:.1f} (15 min)."
     print(text)
-    (out / "profile.json").write_text(json.dumps({"total_s": total, "cpu_s": cpu, "rows": ROWS, "lm_calls": LM_CALLS,
+    (out / "profile.json").write_text(json.dumps({"total_s": total, "cpu_s": cpu, "rows": ROWS, "cpu": CPU, "lm_calls": LM_CALLS,
                                                   "cache": str(cache), "loadavg": load}, indent=1))
     print(f"profile: {out / 'profile.json'}", file=sys.stderr)
     return code

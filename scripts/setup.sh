@@ -159,7 +159,7 @@ show_pip() {
   sed -u -n -E \
     -e 's/^ *(Downloading|Using cached|Building wheel for|Created wheel for|Successfully built) (.{0,110}).*/    \1 \2/p' \
     -e 's/^(Installing collected packages: .{0,100}).*/    \1.../p' \
-    -e 's/^ *\[ *([0-9]+)\/([0-9]+)\] (Building|Linking) [A-Z]+ [a-z ]*(.{0,80}).*/    llama.cpp build [\1\/\2] \3 \4/p' \
+    -e 's/^ *\[ *([0-9]+)\/([0-9]+)\] .* -o ([^ ]*\/)?([^ /]+)( .*)?$/    llama.cpp build [\1\/\2] \4/p' \
     -e '/^ERROR: /{/Mosek/!p}'
 }
 

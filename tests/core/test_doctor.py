@@ -64,6 +64,7 @@ def _model_checks(results: list[Check]) -> Check:
 @pytest.mark.slow
 def test_doctor_reports_a_wrong_model_file(tmp_path, monkeypatch, capsys):
     from gift_llm import embedded
+    from gift_llm.doctor import check_embedded_model
 
     monkeypatch.setenv("GIFT_CACHE_DIR", str(tmp_path))
     path = tmp_path / "models" / embedded.MODEL_FILENAME
@@ -72,19 +73,19 @@ def test_doctor_reports_a_wrong_model_file(tmp_path, monkeypatch, capsys):
     model = _model_checks(run_checks(gift.get_manager(), quick=True))
     assert model.status == "fail" and f"{len(b'GGUF but cut short')} bytes" in model.detail
     assert model.fix == "gift lm install --force"
-
-    with open(path, "r+b") as f:  # the right size, the wrong bytes (sparse: no 1 GB write)
-        f.truncate(embedded.EXPECTED_SIZE)
-    model = _model_checks(run_checks(gift.get_manager()))
-    assert model.status == "fail" and f"expected {embedded.EXPECTED_SHA256}" in model.detail
-    assert model.fix == "gift lm install --force"
     # through the command: exit 1, the fix printed under the failing line
     assert gift.cli.main(["doctor", "--quick"]) == 1
     out = capsys.readouterr().out
     assert "FAIL  embedded model" in out and "fix: gift lm install --force" in out
 
+    with open(path, "r+b") as f:  # the right size, the wrong bytes (sparse: no 1 GB write)
+        f.truncate(embedded.EXPECTED_SIZE)
+    model = check_embedded_model(quick=True)  # no verification marker: hashed even with --quick
+    assert model.status == "fail" and f"expected {embedded.EXPECTED_SHA256}" in model.detail
+    assert model.fix == "gift lm install --force"
+
     path.unlink()  # not assembled yet, but the part packages are installed: assembled on first use
-    model = _model_checks(run_checks(gift.get_manager(), quick=True))
+    model = check_embedded_model(quick=True)
     assert model.status == "warn" and model.fix == "gift lm install"
 
 
