@@ -34,7 +34,7 @@ and keeps every completed result in ``error.completed`` so nothing already compu
 LM concurrency: :class:`RateLimit` caps how many calls to one LM backend run at once across all
 processes of a machine (a set of ``flock``-ed slot files; a slot held by a process that dies is freed
 by the kernel). :meth:`Executor.rate_limit` returns the right limiter for an executor (the Ray plugin
-returns a cluster-wide one); :class:`RateLimitedLM` wraps any :class:`~gift.core.interfaces.LMBackend`.
+returns a cluster-wide one); ``gift_llm.wrappers.RateLimitedLM`` wraps any LM backend with one.
 
 CLI commands that run sweeps call :func:`add_executor_argument` on their parser and
 :func:`executor_from_args` in ``run``; Python functions that take an ``executor=`` argument (an instance,
@@ -62,9 +62,7 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from gift.core.data import Completion, Message
 from gift.core.errors import GiftError, ValidationError
-from gift.core.interfaces import LMBackend
 
 DEFAULT_EXECUTOR = "local"
 
@@ -528,35 +526,6 @@ class RateLimit(ConcurrencyLimit):
         return f"RateLimit(max_concurrent={self.max_concurrent}, key={self.key!r}, directory={self.directory!r})"
 
 
-class RateLimitedLM(LMBackend):
-    """Any LM backend with its calls capped by a :class:`ConcurrencyLimit`.
-
-    ``identity()`` is the wrapped backend's, so caches keyed by it are shared with the unwrapped backend.
-    Put the limit *inside* a cache when you can (only misses need a slot); wrapping a cached backend
-    is correct but holds a slot during hits too.
-    """
-
-    name: ClassVar[str] = "rate-limited"
-
-    def __init__(self, backend: LMBackend, limit: ConcurrencyLimit) -> None:
-        if not isinstance(backend, LMBackend):
-            raise ValidationError(f"RateLimitedLM: backend must be an LMBackend, got {type(backend).__name__}")
-        self.backend, self.limit = backend, limit
-        self.model = backend.model
-        self.supports_choice_probabilities = backend.supports_choice_probabilities
-
-    def complete(self, messages: Sequence[Message], **kwargs: Any) -> Completion:
-        with self.limit:
-            return self.backend.complete(messages, **kwargs)
-
-    def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
-        with self.limit:
-            return self.backend.choice_probabilities(messages, choices)
-
-    def identity(self) -> str:
-        return self.backend.identity()
-
-
 @contextlib.contextmanager
 def limited(limit: ConcurrencyLimit | None) -> Iterator[None]:
     """``with limited(limit_or_None):`` - hold a slot when a limit is given, do nothing otherwise."""
@@ -569,7 +538,7 @@ def limited(limit: ConcurrencyLimit | None) -> Iterator[None]:
 
 __all__ = [
     "DEFAULT_EXECUTOR", "ConcurrencyLimit", "ExecutionError", "Executor", "ExecutorError", "ItemFailure",
-    "LocalExecutor", "RateLimit", "RateLimitedLM", "SerialExecutor", "add_executor_argument", "assemble",
+    "LocalExecutor", "RateLimit", "SerialExecutor", "add_executor_argument", "assemble",
     "check_picklable", "chunk_bounds", "default_lock_directory", "executor_from_args", "get_executor",
     "item_seeds", "limited", "run_chunk", "using_executor",
 ]

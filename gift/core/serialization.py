@@ -9,8 +9,9 @@ from typing import Any
 import numpy as np
 
 #: What :func:`to_jsonable` does with NaN and ±inf: keep the float (``json`` writes ``NaN``/``Infinity``,
-#: which Python reads back), write it as a string (``"nan"``, ``"inf"``), or write ``null`` (NaN only).
-NONFINITE = ("keep", "string", "null-nan")
+#: which Python reads back), write it as a string (``"nan"``, ``"inf"``), write ``null`` for NaN only
+#: (``null-nan``), or ``null`` for every non-finite value, array elements included (``null``: strict JSON).
+NONFINITE = ("keep", "string", "null-nan", "null")
 
 
 def to_jsonable(value: Any, nonfinite: str = "keep") -> Any:
@@ -26,6 +27,8 @@ def _convert(value: Any, nonfinite: str) -> Any:
     if isinstance(value, (list, tuple)):
         return [_convert(v, nonfinite) for v in value]
     if isinstance(value, np.ndarray):  # element values as they are (arrays hold data, not metadata)
+        if nonfinite == "null" and value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+            return _convert(value.tolist(), nonfinite)
         return value.tolist()
     if isinstance(value, np.generic):
         value = value.item()
@@ -33,5 +36,7 @@ def _convert(value: Any, nonfinite: str) -> Any:
         if nonfinite == "string":
             return str(value)
         if nonfinite == "null-nan" and math.isnan(value):
+            return None
+        if nonfinite == "null":
             return None
     return value

@@ -42,7 +42,7 @@ KINDS: dict[str, str] = {
     "command": "gift_register_commands",
 }
 
-BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors")
+BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators")
 
 
 class PluginWarning(UserWarning):
@@ -140,12 +140,22 @@ class GiftPluginManager:
     def _registrar(self, kind: str, plugin_name: str) -> Callable[..., None]:
         dist = self._distribution.get(plugin_name, "?")
 
-        def register(name: str, factory: Any, *, description: str = "", help: str = "", **extra: Any) -> None:
+        def register(name: Any, factory: Any = None, *, description: str = "", help: str = "", **extra: Any) -> None:
             description = description or help
+            if factory is None and not isinstance(name, str):  # register(MyKernel): the name is the class's
+                factory, name = name, getattr(name, "name", None)
+                if not isinstance(name, str):
+                    raise PluginError(f"plugin {plugin_name!r} registered a {kind} {factory!r} without a name: "
+                                      f"give it a class attribute 'name' or call register('name', factory)")
             if not isinstance(name, str) or not name.strip():
                 raise PluginError(f"plugin {plugin_name!r} registered a {kind} with an invalid name {name!r}")
             if factory is None:
                 raise PluginError(f"plugin {plugin_name!r} registered {kind} {name!r} without a factory")
+            own = getattr(factory, "name", None) if isinstance(factory, type) else None
+            if isinstance(own, str) and own != name:
+                raise PluginError(f"plugin {plugin_name!r} registered the {kind} class {factory.__name__} as {name!r}, "
+                                  f"but its name attribute is {own!r}: a component's name has one source; "
+                                  f"use register({factory.__name__}) or make them agree")
             existing = self._registry[kind].get(name)
             if existing is not None:
                 raise PluginError(f"two plugins register the {kind} {name!r}: {existing.plugin!r} (distribution "
@@ -176,7 +186,14 @@ class GiftPluginManager:
             raise UnknownComponentError(f"no {kind} named {name!r}; registered: {known}{hint}") from None
 
     def create(self, kind: str, name: str, **options: Any) -> Any:
-        return self.get(kind, name).create(**options)
+        """Build ``name`` of ``kind``; the built component must carry that name (when it has a ``name``)."""
+        comp = self.get(kind, name)
+        obj = comp.create(**options)
+        own = getattr(obj, "name", None) if kind not in ("suite", "command") else None
+        if isinstance(own, str) and own != name:
+            raise PluginError(f"the {kind} registered as {name!r} by plugin {comp.plugin!r} built a "
+                              f"{type(obj).__name__} named {own!r}: a component's name has one source")
+        return obj
 
     def suites(self) -> dict[str, str]:
         return {c.name: str(c.factory) for c in self._registry["suite"].values()}

@@ -10,8 +10,10 @@ import pytest
 import yaml
 
 import gift
+from gift.study.chain import ORACLE, StudyConfig
+from gift.study.progress import Progress
+from gift.study.sweeps import run_study
 from gift_experiments.report import headline_table, write_report
-from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm, pytest.mark.drake]
 
@@ -45,10 +47,10 @@ def mini_suite(path):
 def reduced(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce")
     suite = mini_suite(out / "mini-suite.yaml")
-    cfg = ReproduceConfig(suite=str(suite), kernels=KERNELS, seeds=2, pairs=60, samples=1, train_scenes=2,
+    cfg = StudyConfig(suite=str(suite), kernels=KERNELS, seeds=2, pairs=60, samples=1, train_scenes=2,
                           demos_per_scene=4, alternatives_per_scene=12, trajectories_per_generator=6,
                           sanity_reps=1, thresholds=("train-calibrated", "oracle"), rq3=True)
-    results = run(cfg, out, Progress(False), log=lambda m: None)
+    results = run_study(cfg, out, Progress(False))
     return cfg, out, results
 
 
@@ -96,7 +98,7 @@ def test_report_figures_and_results_json(reduced):
 
 def test_rerun_resumes_from_the_caches_without_model_calls(reduced):
     cfg, out, results = reduced
-    again = run(cfg, out, Progress(False), log=lambda m: None)
+    again = run_study(cfg, out, Progress(False))
     # NaN (an AUC of a one-class subset) must compare equal to NaN: assert_equal does that
     np.testing.assert_equal(again["rq1"], results["rq1"])
     np.testing.assert_equal(again["rq2"], results["rq2"])

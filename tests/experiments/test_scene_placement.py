@@ -8,8 +8,8 @@ import pytest
 
 import gift
 from gift.core.errors import PlacementError
-from gift_experiments.reproduce import Components, ReproduceConfig, _placed_scene
-from gift_experiments.reproduce import test_scene as make_test_scene  # not a test
+from gift.study.scenes import place_scene
+from gift.study.scenes import test_scene as make_test_scene  # not a test
 
 pytestmark = [pytest.mark.drake]
 
@@ -24,15 +24,14 @@ def setting():
     spec = suite.intent("reading_material")
     rel = [t.object for t in spec.test if t.relevant]
     irr = [t.object for t in spec.test if not t.relevant]
-    return Components(ReproduceConfig(robot="jaco")), suite, spec, rel, irr
+    return gift.get_simulator("drake-jaco"), suite, spec, rel, irr
 
 
 def test_a_pick_that_does_not_fit_is_replaced_by_the_next_pick_of_the_same_seed(setting):
-    comp, suite, spec, rel, irr = setting
-    sim = comp.simulator("jaco")
+    sim, suite, spec, rel, irr = setting
     with pytest.raises(PlacementError, match="1 random picks of 4 objects"):
-        _placed_scene(sim, suite, spec.task, rel, irr, 4, SEED, attempts=1)
-    scene = make_test_scene(comp, suite, spec, "jaco", SEED)
+        place_scene(sim, suite, spec.task, rel, irr, 4, SEED, attempts=1)
+    scene = make_test_scene(sim, suite, spec, 4, SEED)
     assert len(scene.object_names) == 4
     assert scene.relevant and set(scene.object_names) - set(scene.relevant)
-    assert make_test_scene(comp, suite, spec, "jaco", SEED).object_names == scene.object_names  # deterministic
+    assert make_test_scene(sim, suite, spec, 4, SEED).object_names == scene.object_names  # deterministic

@@ -1,20 +1,14 @@
-"""CLI subcommands of gift_kernels: ``gift align`` and ``gift evaluate-alignment``.
-
-(``gift infer-intent`` lives in its own functions below those, owned by the intent-estimation part.)
-"""
+"""``gift align``: align test objects to training objects with one kernel (``gift infer-intent``: intent_cli)."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import sys
 from collections.abc import Sequence
-from pathlib import Path
 
 from gift.core.data import DISTRACTOR, Intent, ObjectSpec
 from gift.core.errors import GiftError
-from gift.core.executor import add_executor_argument, executor_from_args
-from gift_kernels.alignment import THRESHOLDS, score_alignment
+from gift.core.alignment import THRESHOLDS, score_alignment
 
 # ----------------------------------------------------------------------------- gift align
 
@@ -56,7 +50,7 @@ def catalog_objects(names: Sequence[str], suite: str | None = None) -> tuple[Obj
 
 
 def run_align(args: argparse.Namespace) -> int:
-    from gift_kernels.evaluation import _create, parse_kernel_spec
+    from gift.study.components import build, parse_spec
 
     clash = sorted(set(args.train) & set(args.test))
     if clash:
@@ -71,8 +65,8 @@ def run_align(args: argparse.Namespace) -> int:
         except ValueError:
             raise GiftError(f"--threshold must be one of non-oracle, train-calibrated or a number, "
                             f"got {args.threshold!r}") from None
-    name, options = parse_kernel_spec(args.kernel)
-    kernel = _create("kernel", name, args.lm, **options)
+    name, _ = parse_spec(args.kernel)
+    kernel = build("kernel", args.kernel, lm=args.lm)
     train = catalog_objects(args.train, args.suite)
     test = catalog_objects(args.test, args.suite)
     intent = Intent(text=args.intent, source="given") if args.intent else None
@@ -104,53 +98,3 @@ def run_align(args: argparse.Namespace) -> int:
         print(f"  {r['object']:<{width}} -> {r['target']:<20} K={r['score']:.3f}{flag}")
     print(f"alignment error bound per state (L=1): {out['error_bound_per_state']:.3f}")
     return 0
-
-
-# ----------------------------------------------------------------------------- gift evaluate-alignment
-
-
-def configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--suite", required=True, help="registered suite name or a suite YAML file")
-    p.add_argument("--kernels", required=True,
-                   help="comma-separated kernels, each a registered name optionally with :key=value options, "
-                        "e.g. language,language:use_descriptions=true,vision")
-    p.add_argument("--intent-source", default="ground-truth", choices=("ground-truth", "inferred"),
-                   help="ground-truth intent text, or inferred by the GIFT front half (Drake demos + LM)")
-    p.add_argument("--threshold", default=",".join(THRESHOLDS),
-                   help=f"comma-separated threshold strategies (default: all of {','.join(THRESHOLDS)})")
-    p.add_argument("--intents", default=None, help="comma-separated intent ids (default: all)")
-    p.add_argument("--lm", default=None, help="LM backend for LM kernels and intent inference")
-    p.add_argument("--json", action="store_true", help="print the full result as JSON")
-    p.add_argument("--out", default=None, metavar="FILE", help="also write the full JSON result to FILE")
-    p.add_argument("--detailed", action="store_true", help="also print every metric per subset")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
-    add_executor_argument(p)  # one item per (kernel, intent); serial checkpoints --out after every item
-
-
-def _progress(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
-def run_evaluate_alignment(args: argparse.Namespace) -> int:
-    from gift_kernels.evaluation import evaluate_alignment, format_report
-
-    kernels = [k.strip() for k in args.kernels.split(",") if k.strip()]
-    if not kernels:
-        raise GiftError("--kernels is empty")
-    thresholds = [t.strip() for t in args.threshold.split(",") if t.strip()]
-    intents = [i.strip() for i in args.intents.split(",")] if args.intents else None
-    progress = None if args.quiet else _progress
-
-    def write(result: dict) -> None:  # serial: after every kernel x intent, so an interrupted run keeps its numbers
-        tmp = Path(str(args.out) + ".tmp")
-        tmp.write_text(json.dumps(result, indent=2), encoding="utf-8")
-        tmp.replace(args.out)
-
-    with executor_from_args(args) as executor:
-        result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
-                                    lm=args.lm, intents=intents, progress=progress,
-                                    checkpoint=write if args.out else None, executor=executor,
-                                    echo=progress is not None and not executor.in_process and executor.live_stderr)
-    print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
-    failed = [k for k, d in result["kernels"].items() if d["errors"]]
-    return 1 if len(failed) == len(kernels) else 0

@@ -23,11 +23,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+import gift
+
 from gift.core.data import DemonstrationPair, Intent, Motivation, SemanticAxis
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import IntentEstimator, LMBackend
 from gift_kernels import prompts
-from gift_kernels.lm_kernels import resolve_lm
 
 
 def _norm(s: Any) -> str:
@@ -128,7 +129,7 @@ class LMContrastiveIntentEstimator(IntentEstimator):
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            self._lm = resolve_lm(self._lm_spec)
+            self._lm = gift.resolve_lm(self._lm_spec)
         return self._lm
 
     # ------------------------------------------------------------------ prompt material

@@ -33,24 +33,15 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
+import gift
+
+from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec, RelevanceScores
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
-from gift.core.interfaces import LMBackend, SimilarityKernel
+from gift.core.interfaces import LMBackend, RelevanceKernel, SimilarityKernel
 from gift_kernels import prompts
 
 #: Log-odds are clipped to ±LOGIT_CLIP (probabilities of exactly 0 or 1 would be infinite).
 LOGIT_CLIP = 12.0
-
-
-def resolve_lm(lm: LMBackend | str | None) -> LMBackend:
-    """An LM backend instance: ``lm`` itself, or ``gift_llm.resolve_lm(name_or_None)`` (the embedded default)."""
-    if isinstance(lm, LMBackend) or (lm is not None and not isinstance(lm, str) and hasattr(lm, "complete")):
-        return lm
-    try:
-        import gift_llm
-    except ImportError as e:  # pragma: no cover - gift-llm is a dependency of gift-kernels
-        raise GiftError("the LM kernels need the gift-llm plugin (pip install -e plugins/llm)") from e
-    return gift_llm.resolve_lm(lm)
 
 
 def _object_names(objs: Sequence[ObjectSpec | str]) -> list[str]:
@@ -145,7 +136,7 @@ class MappingKernel(SimilarityKernel):
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            self._lm = resolve_lm(self._lm_spec)
+            self._lm = gift.resolve_lm(self._lm_spec)
         return self._lm
 
     def _sample(self, test: list[str], train: list[str], intent: Intent | None, k: int) -> dict[str, str]:
@@ -241,7 +232,7 @@ def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
     return float("nan") if math.isnan(auc) else max(auc - 0.5, 0.0)
 
 
-class GiftProbKernel(SimilarityKernel):
+class GiftProbKernel(RelevanceKernel):
     """Continuous GIFT kernel: P(yes) that an object is what the goal is about, as log-odds.
 
     Default recipe (``docs/results/gift_prob.md``): the LM names the kind of object the goal is about
@@ -291,9 +282,6 @@ class GiftProbKernel(SimilarityKernel):
         self.standardize, self.weighting, self.category_from = standardize, weighting, category_from
         self._category_memo: dict[tuple, str] = {}
         self._language = language_kernel
-        self.categories: dict[str, str] = {}  # goal -> the category its test objects were last asked about
-        self.last_weights: dict[str, float] = {}  # term -> weight used by the last scores() call
-        self._last: tuple[tuple, np.ndarray] | None = None  # (train key, LOO train scores) of the last call
         self._memo: dict[tuple, float] = {}
         self._lock = threading.Lock()
         self.calls = 0  # distinct yes/no questions sent to the LM
@@ -307,7 +295,7 @@ class GiftProbKernel(SimilarityKernel):
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            lm = resolve_lm(self._lm_spec)
+            lm = gift.resolve_lm(self._lm_spec)
             if not getattr(lm, "supports_choice_probabilities", False):
                 raise GiftError(
                     f"gift-prob needs token log-probabilities, which the LM backend {lm.identity()!r} does not "
@@ -382,11 +370,7 @@ class GiftProbKernel(SimilarityKernel):
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
         uses_category = "{category}" in prompts.RELEVANCE_TEMPLATES[self.template]
         if categories is None:
-            cat = self.category(intent) if uses_category else None
-            if cat is not None:
-                with self._lock:
-                    self.categories[prompts.goal_text(intent.text)] = cat
-            categories = [cat] * len(objects)
+            categories = [self.category(intent) if uses_category else None] * len(objects)
         elif len(categories) != len(objects):
             raise GiftError(f"gift-prob: {len(categories)} categories for {len(objects)} objects")
         out = np.empty(len(objects))
@@ -410,8 +394,6 @@ class GiftProbKernel(SimilarityKernel):
         handled = [o.name for o in train if o.name in rel]
         alone = [o.name for o in train if o.name not in rel]
         full = self.category(intent, handled, alone)
-        with self._lock:
-            self.categories[prompts.goal_text(intent.text)] = full
         loo = [self.category(intent, [n for n in handled if n != o.name], [n for n in alone if n != o.name])
                for o in train]
         return [full] * len(test) + loo
@@ -448,23 +430,30 @@ class GiftProbKernel(SimilarityKernel):
         return np.nan_to_num(out, nan=0.0)
 
     # ------------------------------------------------------------------ kernel API
-    def scores(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
-               relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
-        """Unsquashed relevance scores of the test ``[n_test]`` and training objects ``[n_train]``.
+    def score(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
+              relevant_train: Sequence[str] = ()) -> RelevanceScores:
+        """One pass over a scene: relevance of the test objects ``[n_test]`` and, leave-one-out, of the
+        training objects ``[n_train]`` (a training object is never compared with itself, and its question
+        uses a category named without it), on one scale, so the training scores can calibrate a cut.
 
-        Training objects are scored leave-one-out (a training object is never compared with itself),
-        on the same scale as the test objects, so they can calibrate a threshold.
+        ``details``: the category the test objects were asked about and the weight of each term.
         """
         test, train = list(test), list(train)
         if intent is None:
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
         rel = self._relevant_mask(train, relevant_train) if relevant_train else None  # unknown names fail first
-        lo = self.log_odds(test + train, intent, self._categories(test, train, intent, relevant_train))
+        categories = self._categories(test, train, intent, relevant_train)
+        lo = self.log_odds(test + train, intent, categories)
         lo_test, lo_train = lo[: len(test)], lo[len(test):]
-        if self.combine == "none":
-            return lo_test, lo_train
         if rel is None:
             rel = self._relevant_mask(train, (), lo_train)
+        details: dict[str, Any] = {}
+        if categories is not None:
+            details["category"] = categories[0] if test else None
+        elif "{category}" in prompts.RELEVANCE_TEMPLATES[self.template]:
+            details["category"] = self.category(intent)
+        if self.combine == "none":
+            return RelevanceScores(_sigmoid(lo_test), _sigmoid(lo_train), rel, details)
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
         ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
@@ -476,52 +465,7 @@ class GiftProbKernel(SimilarityKernel):
             if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
                 w = scaled
         total = sum(w.values())
-        self.last_weights = {t: v / total for t, v in w.items()}
-        z = sum(self.last_weights[t] * terms[t] for t in terms)
-        out = z[: len(test)], z[len(test):]
-        self._last = (self._train_key(train, intent, relevant_train), out[1])
-        return out
-
-    @staticmethod
-    def _train_key(train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str]) -> tuple:
-        return (tuple(train), intent, tuple(sorted(relevant_train)))
-
-    def relevance(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
-                  relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """``r`` ``[n_test]`` in [0, 1]: sigmoid of the relevance score (0.5 = undecided)."""
-        if not test:
-            return np.zeros(0)
-        return _sigmoid(self.scores(test, train, intent, relevant_train)[0])
-
-    def relevance_loo(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
-                      relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
-        """``(r_test [n_test], r_train [n_train])`` in [0, 1] from one call, on one scale.
-
-        ``r_train`` is leave-one-out (no training object is compared with itself): the scores a
-        train-calibrated threshold should separate (relevant training objects vs the others).
-        """
-        s_test, s_train = self.scores(test, train, intent, relevant_train)
-        return _sigmoid(s_test), _sigmoid(s_train)
-
-    def loo_relevance(self, train: Sequence[ObjectSpec], intent: Intent | None = None,
-                      relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """Leave-one-out ``r`` ``[n_train]`` of the training objects (the alignment operator's calibration).
-
-        On the scale of the last :meth:`relevance` call with the same training set, intent and
-        ``relevant_train`` (z-scores depend on the pool of objects scored together); else on its own.
-        """
-        key = self._train_key(train, intent, relevant_train)
-        if self._last is not None and self._last[0] == key:
-            return _sigmoid(self._last[1])
-        return _sigmoid(self.scores([], train, intent, relevant_train)[1])
-
-    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
-                   intent: Intent | None = None, relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """``[n_test, n_train]``: ``r_i`` in the columns of the relevant training objects, 0 elsewhere."""
-        test, train = list(test), list(train)
-        if not test or not train:
-            return np.zeros((len(test), len(train)))
-        s_test, _ = self.scores(test, train, intent, relevant_train)
-        rel = (self._relevant_mask(train, relevant_train) if relevant_train
-               else self._relevant_mask(train, (), self.log_odds(train, intent)))
-        return np.where(rel[None, :], _sigmoid(s_test)[:, None], 0.0)
+        weights = {t: v / total for t, v in w.items()}
+        z = sum(weights[t] * terms[t] for t in terms)
+        details["weights"] = weights
+        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details)
