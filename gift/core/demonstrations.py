@@ -22,10 +22,11 @@ The procedure, per role:
 3. **What the human did differently.** The default trajectories of one scene differ only by the
    simulator's (or the robot's) perturbations, so their activities give each object's noise envelope.
 
-   - *Acting*: a pair's *choice* is the object its preferred trajectory acted on furthest beyond every
-     default trajectory of the scene. An untouched object's activity is exactly 0, so every pair can be
-     read on its own (the human may pick a different object in each demonstration). A pair that did just
-     what its default did chose the default's object, if the human deviated in another pair of the scene.
+   - *Acting*: an untouched object's activity is exactly 0, so every pair can be read on its own (the
+     human may pick a different object in each demonstration): its *choice* is the object its preferred
+     trajectory acted on that no default trajectory of the scene acts on. A pair that acted only on what
+     the default acts on chose the default's object, if the human chose differently in another pair of the
+     scene.
    - *Passing*: every column carries perturbation noise, so a scene is read as a whole: an object is
      *avoided* when every preferred trajectory stayed further from it than every default trajectory did,
      *approached* in the opposite case; each pair's choice is the avoided object whose closeness it cut
@@ -188,22 +189,21 @@ def _activity(values: np.ndarray, mode: str) -> np.ndarray:
 def acting_choices(pref: np.ndarray, default: np.ndarray) -> np.ndarray:
     """Acting role: per pair of one scene, the weight of each object as the human's choice.
 
-    ``pref`` ``[n, k]``, ``default`` ``[n, k]``: activities of the ``k`` objects present, pair by pair.
-    A pair's choice is the object acted on furthest beyond every default trajectory of the scene (split on
-    ties). A pair that acts beyond the defaults on nothing did what its default did: its choice is the
-    default's own object, provided the human deviated in some other pair of the scene (if the human never
-    deviates, the scene carries no evidence). A pair acting beyond the defaults on every object singles out
-    none. Returns ``[n, k]``, one unit per informative pair.
+    ``pref`` ``[n, k]``, ``default`` ``[n, k]``: activities of the ``k`` objects present, pair by pair. An
+    untouched object's activity is exactly 0, so what a trajectory acts on is exact. A pair's choice is the
+    object its preferred trajectory acted on most among those no default trajectory of the scene acts on
+    (split on ties). A pair that acts on none of those did what the default does: its choice is its
+    default's own object, provided the human chose differently in some other pair of the scene (if the
+    human never does, the scene carries no evidence). A pair acting on every object singles out none.
+    Returns ``[n, k]``, one unit per informative pair.
     """
-    excess = pref - default.max(axis=0)
-    excess = np.where(excess > _TOL, excess, 0.0)
-    out = np.zeros_like(excess)
+    fresh = pref * (default.max(axis=0) <= _TOL)[None, :]
+    out = np.zeros_like(pref)
     same = []
-    for i, row in enumerate(excess):
-        beyond = row > 0
-        if beyond.all():
+    for i, row in enumerate(fresh):
+        if (pref[i] > _TOL).all():
             continue
-        if beyond.any():
+        if row.max() > _TOL:
             top = row >= row.max() - _TOL
             out[i, top] = 1.0 / top.sum()
         else:

@@ -210,3 +210,24 @@ def test_pairs_with_different_columns_are_rejected():
     b = acting_pairs(LAYOUTS[:1], n=1, specs=acting_specs(OBJECTS[:5]))
     with pytest.raises(ValidationError, match="other feature columns"):
         infer_relevant_objects(a + b, OBJECTS)
+
+
+def test_scenes_without_a_relevant_object_carry_no_evidence():
+    """Twelve objects, scenes of five drawn at random: where no relevant object is present the human does
+    what the default does, and such scenes neither promote nor demote their objects."""
+    objs = tuple(f"thing{i}" for i in range(12))
+    rng = np.random.default_rng(0)
+    layouts = [tuple(str(o) for o in rng.choice(objs[:-1], 5, replace=False)) for _ in range(10)]
+    layouts.append(("thing11", "thing5", "thing6", "thing7", "thing8"))  # thing11 is only here
+    res = infer_relevant_objects(acting_pairs(layouts, relevant=objs[:3], specs=acting_specs(objs)), objs)
+    assert res.relevant == objs[:3]
+    assert res.undetermined == ("thing11",) and res.unobserved == ()
+
+
+def test_more_objects_than_the_exhaustive_model_handles_is_a_clear_error():
+    from gift.core.demonstrations import MAX_OBJECTS
+
+    objs = tuple(f"thing{i}" for i in range(MAX_OBJECTS + 1))
+    layouts = [objs[i:i + 5] for i in range(0, len(objs) - 4, 4)] + [objs[-5:]]
+    with pytest.raises(ValidationError, match=f"at most {MAX_OBJECTS}"):
+        infer_relevant_objects(acting_pairs(layouts, relevant=objs[:2], n=1, specs=acting_specs(objs)), objs)
