@@ -19,15 +19,15 @@ The procedure, per role:
 2. **Activity** ``A`` of an object's column in one trajectory: acting roles, its total variation
    ``Σ_t |c_{t+1} − c_t|`` (0 for an object nobody touched); passing roles, its closeness summed over time
    ``Σ_t c_t``.
-3. **What the human did differently.** The default trajectories of one scene differ only by the
-   simulator's (or the robot's) perturbations, so their activities give each object's noise envelope.
+3. **What the human did differently**, scene by scene (the pairs of one scene share its layout):
 
    - *Acting*: an untouched object's activity is exactly 0, so every pair can be read on its own (the
      human may pick a different object in each demonstration): its *choice* is the object its preferred
      trajectory acted on that no default trajectory of the scene acts on. A pair that acted only on what
      the default acts on chose the default's object, if the human chose differently in another pair of the
      scene.
-   - *Passing*: every column carries perturbation noise, so a scene is read as a whole: an object is
+   - *Passing*: every column carries the perturbation noise of the trajectories, so a scene is read as a
+     whole, against the range of its default trajectories (which differ only by that noise): an object is
      *avoided* when every preferred trajectory stayed further from it than every default trajectory did,
      *approached* in the opposite case; each pair's choice is the avoided object whose closeness it cut
      by the largest fraction.
