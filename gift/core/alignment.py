@@ -268,8 +268,10 @@ class AlignmentScores:
             return self.train_mean, "mean K over training pairs"
         if strategy == "train-calibrated":
             if not self.relevant_train:
-                raise GiftError("the train-calibrated threshold needs the relevant training objects "
-                                "(relevant_train / --relevant) to tell positives from negatives")
+                if self.train_mean is None:
+                    raise GiftError("the train-calibrated threshold needs the relevant training objects "
+                                    "(relevant_train / --relevant) to tell positives from negatives")
+                return self.train_mean, "fallback to non-oracle: no relevant training object is known"
             if self.loo_scores is None:
                 raise GiftError("train-calibrated threshold: leave-one-out scores were not computed; pass "
                                 "need=('train-calibrated',) to score_alignment")

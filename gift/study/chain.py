@@ -212,7 +212,9 @@ def relevant_training(cfg: StudyConfig, spec: IntentSpec, training: TrainingSet 
     from gift.core.demonstrations import infer_relevant_objects
 
     est = infer_relevant_objects(training.pairs(), spec.train_objects)
-    return RelevantTraining(tuple(est.relevant), "demonstrations", est.to_dict())
+    details = est.to_dict()
+    details.pop("relevant")
+    return RelevantTraining(tuple(est.relevant), "demonstrations", details)
 
 
 def infer_intent(comp: Components, cfg: StudyConfig, spec: IntentSpec, training: TrainingSet,

@@ -156,8 +156,11 @@ def test_operator_thresholds_and_errors():
         ArgmaxThresholdAlignment("smart")
     with pytest.raises(GiftError, match=r"\[0, 1\]"):
         ArgmaxThresholdAlignment(1.5)
-    with pytest.raises(GiftError, match="relevant_train"):
-        ArgmaxThresholdAlignment("train-calibrated").align(k, TEST, TRAIN)
+    # no relevant training object known (e.g. demonstrations that single out none): the paper's cut, said so
+    op = ArgmaxThresholdAlignment("train-calibrated")
+    unknown = op.align(k, TEST, TRAIN)
+    assert "no relevant training object" in op.last_note
+    assert unknown.threshold == pytest.approx(score_alignment(k, TEST, TRAIN).threshold("non-oracle")[0])
     with pytest.raises(GiftError, match="not training objects"):
         ArgmaxThresholdAlignment().align(k, TEST, TRAIN, relevant_train=("unicorn",))
 
