@@ -19,7 +19,8 @@ from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift.core.suite import load_suite
 from gift_kernels import prompts
-from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_mapping
+from gift_kernels.lm_kernels import (GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_category_answer,
+                                     parse_mapping)
 
 SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
 
@@ -51,6 +52,11 @@ class ScriptedLM(LMBackend):
 
 class PlainLM(ScriptedLM):
     supports_choice_probabilities = False
+
+
+def category_json(category: str) -> str:
+    """A category answer in the JSON of ``schemas.category_schema``."""
+    return json.dumps({"category": category})
 
 
 def _names_in_order(text: str, key: str) -> list[str]:
@@ -144,7 +150,7 @@ def _probs_by_name(table):
 def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
              "toothbrush": 0.4, "apple": 0.05}
-    lm = ScriptedLM(answer=lambda m, s: "Art supplies.", probs=_probs_by_name(table))
+    lm = ScriptedLM(answer=lambda m, s: category_json("Art supplies."), probs=_probs_by_name(table))
     k = GiftProbKernel(lm=lm, combine="none", category_from="goal")
     lo = k.log_odds(TEST, ART)
     assert np.allclose(lo, [np.log(0.7 / 0.3), np.log(0.4 / 0.6), np.log(0.05 / 0.95)])
@@ -168,7 +174,7 @@ def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
 def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects_leaving_each_one_out():
     def answer(messages, seed):  # the category the scripted LM names: from the last question's handled objects
         m = re.search(r"handled as part of this goal: (.*)\.\n", messages[-1].content)
-        return "drawing books" if m and "paintbrush" not in m.group(1) else "art supplies"
+        return category_json("drawing books" if m and "paintbrush" not in m.group(1) else "art supplies")
 
     lm = ScriptedLM(answer=answer, probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2,
                                                           "coffee mug": 0.1, "crayons": 0.7, "toothbrush": 0.4,
@@ -201,7 +207,7 @@ def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects
 def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_questions_each_once():
     from gift.core.alignment import score_alignment
 
-    lm = ScriptedLM(answer=lambda m, s: "art supplies" if "handled" in m[-1].content else "art things",
+    lm = ScriptedLM(answer=lambda m, s: category_json("art supplies" if "handled" in m[-1].content else "art things"),
                     probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1,
                                           "crayons": 0.7, "toothbrush": 0.4, "apple": 0.05}))
     k = GiftProbKernel(lm=lm, combine="none")
@@ -239,7 +245,8 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
-        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=lambda t: {"yes": .5, "no": .5}),
+        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                     probs=lambda t: {"yes": .5, "no": .5}),
                        combine="none").score(TEST, TRAIN, ART, relevant_train=("ghost",))
 
 
@@ -258,13 +265,17 @@ def test_category_answers_are_parsed_or_fall_back_to_the_goal_with_a_warning():
     assert prompts.parse_category("Answer: the valuables") == "valuables"
     for bad in ("", "   \n ", "these are all the objects that the goal could possibly be about here"):
         assert prompts.parse_category(bad) is None
-    lm = ScriptedLM(answer=lambda m, s: "", probs=lambda t: {"yes": 0.6, "no": 0.4})
+    # an answer that is no short noun phrase is asked again once, then the goal stands in
+    answers = iter(["", category_json("these are all the objects that the goal could possibly be about here")])
+    lm = ScriptedLM(answer=lambda m, s: next(answers), probs=lambda t: {"yes": 0.6, "no": 0.4})
     k = GiftProbKernel(lm=lm, combine="none")
     with pytest.warns(UserWarning, match="no object category.*pack art supplies"):
         k.log_odds(TEST[:1], ART)
     assert 'one of the things the goal "pack art supplies" is about?' in lm.calls[-1][0][1].content
-    k.log_odds(TEST[1:], ART)  # the goal's category is asked once
-    assert sum(c[0][0].content == prompts.CATEGORY_SYSTEM for c in lm.calls) == 1
+    k.log_odds(TEST[1:], ART)  # the goal's category is asked once (the first answer and one repair)
+    asked = [c[0] for c in lm.calls if c[0][0].content == prompts.CATEGORY_SYSTEM]
+    assert len(asked) == 2 and "no Python dictionary" in asked[1][-1].content
+    assert parse_category_answer({"category": "the Art supplies."}) == {"category": "Art supplies"}
 
 
 class TableKernel(SimilarityKernel):
@@ -291,7 +302,8 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
     rel = ("paintbrush", "sketchbook")
 
     def kernel(weighting):
-        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=_probs_by_name(table)),
+        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                            probs=_probs_by_name(table)),
                               weighting=weighting, language_kernel=TableKernel(vec))
 
     k = kernel("reliability")

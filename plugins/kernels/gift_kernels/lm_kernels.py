@@ -38,7 +38,7 @@ import gift
 from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec, RelevanceScores
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, RelevanceKernel, SimilarityKernel
-from gift_kernels import prompts
+from gift_kernels import prompts, schemas
 
 #: Log-odds are clipped to ±LOGIT_CLIP (probabilities of exactly 0 or 1 would be infinite).
 LOGIT_CLIP = 12.0
@@ -74,6 +74,13 @@ def _valid_part(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[
             continue
         out[t] = target
     return out, unknown_targets
+
+
+def mapping_max_tokens(test: Sequence[str], train: Sequence[str]) -> int:
+    """Token budget of one Call-3 answer: every test object with the longest target, at about 3
+    characters per token, plus room; at least 512."""
+    longest = max([len(DISTRACTOR), *map(len, train)])
+    return max(512, 64 + sum(len(t) + longest + 8 for t in test) // 3)
 
 
 def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]) -> dict[str, str]:
@@ -124,14 +131,19 @@ class MappingKernel(SimilarityKernel):
     uses_intent: ClassVar[bool] = True
 
     def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
-                 seed: int = 0, use_intent: bool = True, max_repairs: int = 2) -> None:
+                 seed: int = 0, use_intent: bool = True, max_repairs: int = 2, constrained: bool = True) -> None:
+        from gift_llm.structured import AskStats
+
         if not isinstance(samples, int) or samples < 1:
             raise GiftError(f"{self.name} kernel: samples must be a positive integer, got {samples!r}")
         self._lm_spec, self._lm = lm, None
         self.samples, self.temperature, self.seed = samples, float(temperature), int(seed)
         self.use_intent, self.max_repairs = bool(use_intent), int(max_repairs)
+        #: Send Call 3's JSON schema (``schemas.mapping_schema``) with every request (False: free text).
+        self.constrained = bool(constrained)
         self.calls = 0  # LM calls made (including those served from the LM cache)
         self.fallbacks: list[str] = []  # samples completed by default (see _sample)
+        self.stats = AskStats()  # answers read, repair requests, samples still invalid after the repairs
 
     @property
     def lm(self) -> LMBackend:
@@ -146,10 +158,12 @@ class MappingKernel(SimilarityKernel):
         t_order = [test[i] for i in rng.permutation(len(test))]
         s_order = [train[i] for i in rng.permutation(len(train))]
         messages = prompts.mapping_messages(t_order, s_order, intent)
+        schema = schemas.mapping_schema(t_order, s_order) if self.constrained else None
         self.calls += 1
         try:
             answer = ask_dict(self.lm, messages, validate=lambda d: parse_mapping(d, test, train),
-                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k)
+                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k,
+                              max_tokens=mapping_max_tokens(test, train), json_schema=schema, stats=self.stats)
         except LMAnswerError as e:
             # still incomplete after the repairs: keep the valid part of the last answer; an object it
             # leaves unmapped (or maps to an unknown name) aligns to nothing, i.e. distractor. An answer
@@ -195,9 +209,9 @@ class NoIntentMappingKernel(MappingKernel):
     uses_intent: ClassVar[bool] = False
 
     def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
-                 seed: int = 0, max_repairs: int = 2) -> None:
+                 seed: int = 0, max_repairs: int = 2, constrained: bool = True) -> None:
         super().__init__(lm=lm, samples=samples, temperature=temperature, seed=seed, use_intent=False,
-                         max_repairs=max_repairs)
+                         max_repairs=max_repairs, constrained=constrained)
 
 
 # ============================================================================= gift-prob
@@ -218,6 +232,16 @@ EMBED_REFERENCE = ("relevant", "contrastive")
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
+
+
+def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
+    """Validate a category answer ``{"category": <noun phrase>}``: the phrase cleaned by
+    :func:`gift_kernels.prompts.parse_category`; :class:`ValidationError` when it is no short noun phrase."""
+    value = answer.get("category")
+    cat = prompts.parse_category(value) if isinstance(value, str) else None
+    if cat is None:
+        raise ValidationError(f"'category' must be a short plural noun phrase (at most 8 words), got {value!r}")
+    return {"category": cat}
 
 
 def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
@@ -261,7 +285,8 @@ class GiftProbKernel(RelevanceKernel):
     def __init__(self, lm: LMBackend | str | None = None, template: str = "category", use_descriptions: bool = True,
                  axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
-                 category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None) -> None:
+                 category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
+                 constrained: bool = True) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -281,6 +306,8 @@ class GiftProbKernel(RelevanceKernel):
         self.combine, self.embed_reference, self.weight = combine, embed_reference, float(weight)
         self.standardize, self.weighting, self.category_from = standardize, weighting, category_from
         self._category_memo: dict[tuple, str] = {}
+        #: Send the category call's JSON schema (``schemas.category_schema``) with each request.
+        self.constrained = bool(constrained)
         self._language = language_kernel
         self._memo: dict[tuple, float] = {}
         self._lock = threading.Lock()
@@ -346,14 +373,18 @@ class GiftProbKernel(RelevanceKernel):
         with self._lock:
             if key in self._category_memo:
                 return self._category_memo[key]
+        from gift_llm.structured import ask_dict
+
         msgs = (prompts.category_from_objects_messages(goal, handled, left_alone) if use_objects
                 else prompts.category_messages(goal))
-        answer = self.lm.complete(msgs, temperature=0.0, max_tokens=24, stop=["\n"]).text
         self.calls += 1
-        cat = prompts.parse_category(answer)
-        if cat is None:
+        try:
+            cat = ask_dict(self.lm, msgs, validate=parse_category_answer, max_repairs=1, temperature=0.0,
+                           max_tokens=32, json_schema=schemas.category_schema() if self.constrained else None,
+                           required_keys=("category",))["category"]
+        except LMAnswerError as e:
             warnings.warn(f"gift-prob: the LM named no object category for the goal {goal!r} (answer "
-                          f"{answer[:80]!r}); asking about the goal itself", stacklevel=2)
+                          f"{e.raw[:80]!r}); asking about the goal itself", stacklevel=2)
             cat = prompts.fallback_category(goal)
         with self._lock:
             self._category_memo[key] = cat

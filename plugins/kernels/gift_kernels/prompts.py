@@ -33,7 +33,8 @@ Reply with one JSON object and nothing else:
 {"motivations": [{"text": "<one or two sentences>", "features": ["<feature name>", ...]}, ... three entries, \
 most likely first],
  "semantic_similarities": [{"question": "<a short yes/no question>", "features": ["<feature name>", ...]}, ...]}
-Use only feature names that appear in the recordings or in the list of other features."""
+Name one to four features per entry and at most three semantic similarities. Use only feature names that \
+appear in the recordings or in the list of other features."""
 
 
 def intent_messages(pairs_text: Sequence[tuple[str, str]], descriptions: Mapping[str, str],
@@ -64,7 +65,8 @@ motivations and a list of object names. Write short yes/no questions (for exampl
 and, for each question, the objects for which the answer is yes. Use only the given object names; put \
 each object under at most one question; avoid vague questions such as "is it an object?".
 
-Reply with one JSON object and nothing else: {"axes": [{"question": "...", "objects": ["...", ...]}, ...]}"""
+Reply with one JSON object and nothing else: {"axes": [{"question": "...", "objects": ["...", ...]}, ...]} \
+with one to six questions, each with at least one object."""
 
 
 def axes_messages(motivations: Sequence[tuple[str, Sequence[str]]], objects: Sequence[str]) -> tuple[Message, ...]:
@@ -84,7 +86,8 @@ yes/no grouping questions). Map every new object either to the training object w
 judged by purpose and use rather than by name or looks, or to "{DISTRACTOR}" when it takes no training \
 object's role. Several new objects may map to the same training object.
 
-Reply with one JSON object and nothing else: {{"<new object>": "<training object or {DISTRACTOR}>", ...}}"""
+Reply with one JSON object and nothing else: {{"<new object>": "<training object or {DISTRACTOR}>", ...}} \
+with every new object as a key, in the order they are listed."""
 
 
 def intent_context(intent: Intent) -> str:
@@ -145,7 +148,13 @@ def goal_text(text: str) -> str:
 
 # ----------------------------------------------------------------------------- goal category (gift-prob)
 
-CATEGORY_SYSTEM = "You name the kind of object a household goal is about, as a short plural noun phrase."
+CATEGORY_SYSTEM = ("You name the kind of object a household goal is about, as a short plural noun phrase. "
+                   'Reply with one JSON object and nothing else: {"category": "<noun phrase>"}')
+
+
+def category_answer(category: str) -> str:
+    """A worked example's answer, in the JSON of ``schemas.category_schema``."""
+    return json.dumps({"category": category})
 
 #: Worked examples shown before the goal (generic household goals, none from a benchmark suite). They
 #: teach the small model to keep the goal's own qualifiers ("gardening tools", not "tools") and, when a
@@ -162,7 +171,8 @@ def category_messages(goal: str) -> tuple[Message, ...]:
     """Ask which kind of object ``goal`` is about (few-shot, answered with a plural noun phrase)."""
     msgs = [Message("system", CATEGORY_SYSTEM)]
     for g, c in CATEGORY_EXAMPLES:
-        msgs += [Message("user", f"Goal: {g}.\nWhich objects is this goal about?"), Message("assistant", c)]
+        msgs += [Message("user", f"Goal: {g}.\nWhich objects is this goal about?"),
+                 Message("assistant", category_answer(c))]
     msgs.append(Message("user", f"Goal: {goal_text(goal)}.\nWhich objects is this goal about?"))
     return tuple(msgs)
 
@@ -196,7 +206,7 @@ def category_from_objects_messages(goal: str, handled: Sequence[str],
         raise ValueError("category_from_objects_messages needs at least one handled object")
     msgs = [Message("system", CATEGORY_SYSTEM)]
     for g, h, a, c in CATEGORY_EXAMPLES_WITH_OBJECTS:
-        msgs += [Message("user", _objects_question(g, h, a)), Message("assistant", c)]
+        msgs += [Message("user", _objects_question(g, h, a)), Message("assistant", category_answer(c))]
     msgs.append(Message("user", _objects_question(goal, handled, left_alone)))
     return tuple(msgs)
 
