@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Sequence
 
 from gift.core.errors import GiftError
+from gift.core.interfaces import DEFAULT_LM_TIMEOUT_S, LM_TIMEOUT_ENV
+from gift.core.redaction import redact_text
 from gift.plugins.manager import KINDS, get_manager
 
 
@@ -31,6 +34,37 @@ def _cmd_plugins(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
+def _parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """``parser`` and every sub-command parser below it."""
+    out = [parser]
+    for action in parser._actions:  # noqa: SLF001 - argparse keeps sub-parsers only there
+        if isinstance(action, argparse._SubParsersAction):  # noqa: SLF001
+            for sub in dict.fromkeys(action.choices.values()):
+                out += _parsers(sub)
+    return out
+
+
+def add_lm_timeout_argument(parser: argparse.ArgumentParser) -> None:
+    """Give every (sub-)command that takes ``--lm`` also ``--lm-timeout SECONDS`` (sets ``$GIFT_LM_TIMEOUT``)."""
+    for p in _parsers(parser):
+        options = {o for a in p._actions for o in a.option_strings}  # noqa: SLF001
+        if "--lm" in options and "--lm-timeout" not in options:
+            p.add_argument("--lm-timeout", type=_positive_seconds, default=None, metavar="SECONDS",
+                           help=f"give up on an LM request (retries included) after this long (default: "
+                                f"${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s for servers; in-process "
+                                f"models only when set)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="gift", description="Generalizing Intent for Flexible Test-time rewards")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -45,6 +79,7 @@ def build_parser() -> argparse.ArgumentParser:
         if configure is not None:
             configure(sp)
         sp.set_defaults(run=comp.factory)
+    add_lm_timeout_argument(parser)
     return parser
 
 
@@ -54,10 +89,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "run", None):
         parser.print_help()
         return 2
+    if getattr(args, "lm_timeout", None) is not None:  # the environment reaches every worker process too
+        os.environ[LM_TIMEOUT_ENV] = repr(args.lm_timeout)
     try:
         code = args.run(args)
     except GiftError as e:
-        print(f"gift {args.command}: error: {e}", file=sys.stderr)
+        print(f"gift {args.command}: error: {redact_text(str(e))}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

@@ -8,15 +8,19 @@ Results layout (every number of a run; figures read only this)::
      "rq2":    {intent: {kernel: {threshold: {subset: {"f1", "fp", "fn", "fp_rate", "fn_rate", "auc", "n"}}}}},
      "scatter": {intent: {"anchor": name, "points": [{"object", "language", "vision", "relevant"}]}},
      "rq3":    {intent: {kernel: {"objects": [...], "relevant": [...], "mean": [...], "se": [...]}}}}
+
+``results.json`` is strict JSON (:func:`gift.core.serialization.write_json`): a number that is not defined
+(the AUC of a subset whose objects are all relevant or all irrelevant) is ``null``, and the means below skip it.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from gift.core.serialization import finite_values, write_json
 
 KERNEL_ORDER = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
 SUBSET_LABEL = {"R": "S_R", "lang": "S_lang", "vis": "S_vis", "unk": "S_unk", "all": "S_R ∪ S_conf"}
@@ -36,8 +40,15 @@ def _plt():
     return plt
 
 
+def _num(x: Any) -> float:
+    """A plotted number: ``null`` (None) and missing values are NaN (matplotlib leaves them out)."""
+    return float("nan") if x is None else float(x)
+
+
 def _grouped_bars(ax, groups: list[str], series: list[str], mean: np.ndarray, se: np.ndarray | None) -> None:
     """``mean``/``se``: ``[n_series, n_groups]``."""
+    mean = np.vectorize(_num, otypes=[float])(mean)
+    se = None if se is None else np.vectorize(_num, otypes=[float])(se)
     width = 0.8 / max(len(series), 1)
     x = np.arange(len(groups))
     for k, name in enumerate(series):
@@ -204,7 +215,7 @@ def win_rate_table(results: dict) -> str:
     for intent, per in rq1.items():
         rows.append(f"| {intent} | " + " | ".join(_fmt(per[k]["mean"], per[k]["se"]) if k in per else "–"
                                                   for k in kernels) + " |")
-    means = {k: [per[k]["mean"] for per in rq1.values() if k in per] for k in kernels}
+    means = {k: finite_values(per[k]["mean"] for per in rq1.values() if k in per) for k in kernels}
     rows.append("| **mean** | " + " | ".join(_fmt(float(np.mean(v))) if v else "–" for v in means.values()) + " |")
     return "\n".join(rows)
 
@@ -219,8 +230,8 @@ def f1_table(results: dict, threshold: str, subset: str = "all") -> str:
         cells = []
         for k in kernels:
             m = per.get(k, {}).get(threshold, {}).get(subset)
-            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and m.get("auc") is not None
-                         and not np.isnan(m["auc"]) else (f"{m['f1']:.2f}" if m else "–"))
+            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and finite_values([m.get("auc")])
+                         else (f"{m['f1']:.2f}" if m else "–"))
         rows.append(f"| {intent} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
@@ -239,9 +250,9 @@ def headline_table(runs: dict[str, dict], threshold: str = "train-calibrated") -
     for k in kernels:
         cells = []
         for res in runs.values():
-            wr = [per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per]
-            f1 = [per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
-                  if threshold in per.get(k, {}) and "all" in per[k][threshold]]
+            wr = finite_values(per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per)
+            f1 = finite_values(per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
+                               if threshold in per.get(k, {}) and "all" in per[k][threshold])
             se = float(np.std(wr, ddof=1) / np.sqrt(len(wr))) if len(wr) > 1 else None
             cells += [_fmt(float(np.mean(wr)), se) if wr else "–", _fmt(float(np.mean(f1))) if f1 else "–"]
         rows.append(f"| {k} | " + " | ".join(cells) + " |")
@@ -252,7 +263,7 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     """Write ``out/report.md`` (tables + figures inline) and ``out/results.json``."""
     out.mkdir(parents=True, exist_ok=True)
     figures = make_figures(results, out)
-    (out / "results.json").write_text(json.dumps(results, indent=2, default=json_default))
+    write_json(out / "results.json", results)
     lines = ["# gift reproduce report", ""]
     if command:
         lines += ["Made by:", "", f"```\n{command}\n```", ""]
@@ -294,12 +305,3 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
-
-
-def json_default(o: Any) -> Any:
-    """``json.dumps(default=...)`` for numpy scalars and arrays."""
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")

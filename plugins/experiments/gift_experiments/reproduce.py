@@ -37,8 +37,8 @@ from gift.core.data import DISTRACTOR, Alignment, DemonstrationPair, FeatureBatc
 from gift.core.errors import GiftError, PlacementError
 from gift.core.executor import ExecutionError, Executor, using_executor
 from gift.core.metrics import boltzmann, mean_se, pairwise_win_rate, sample_pairs
+from gift.core.serialization import write_json
 from gift.core.suite import IntentSpec, Suite
-from gift_experiments.report import json_default
 
 GENERIC_INTENT = "The human prefers to move objects around the table."
 ALL_KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
@@ -98,11 +98,8 @@ class StageCache:
         path = self.root / f"{name}.json"
         if path.exists():
             return json.loads(path.read_text())
-        value = fn()
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(value, default=json_default))
-        tmp.replace(path)
-        return value
+        write_json(path, fn(), indent=None)  # strict JSON (NaN -> null), written atomically
+        return json.loads(path.read_text())  # what a resumed run reads: fresh and resumed runs agree
 
 
 def _seed(*parts: Any) -> int:

@@ -27,6 +27,7 @@ import numpy as np
 from gift.core.data import Intent
 from gift.core.errors import GiftError, ValidationError
 from gift.core.metrics import binary_metrics, roc_auc
+from gift.core.serialization import dumps, finite_values
 from gift.core.suite import Suite, load_suite
 
 #: name -> GiftProbKernel options. The first entry is the default of gift-prob.
@@ -78,8 +79,8 @@ def evaluate_variant(kernel: Any, suite: Suite, intents: Mapping[str, Intent] | 
         preds += list(pred)
         truth += list(labels)
     m = binary_metrics(preds, truth)
-    aucs = [v["auc"] for v in per_intent.values() if not np.isnan(v["auc"])]
-    return {"auc": float(np.mean(aucs)), "f1": m.f1, "precision": m.precision, "recall": m.recall,
+    aucs = finite_values(v["auc"] for v in per_intent.values())  # one-class intents have no AUC
+    return {"auc": float(np.mean(aucs)) if aucs else None, "f1": m.f1, "precision": m.precision, "recall": m.recall,
             "fp": m.fp, "fn": m.fn, "per_intent": per_intent}
 
 
@@ -115,7 +116,8 @@ def format_table(results: Mapping[str, Mapping[str, Any]]) -> str:
     lines = ["| variant | AUC (mean per intent) | F1 (train-calibrated) | precision | recall | FP | FN |",
              "|---|---|---|---|---|---|---|"]
     for name, r in results.items():
-        lines.append(f"| {name} | {r['auc']:.3f} | {r['f1']:.3f} | {r['precision']:.3f} | {r['recall']:.3f} | "
+        auc = "n/a" if r["auc"] is None else f"{r['auc']:.3f}"
+        lines.append(f"| {name} | {auc} | {r['f1']:.3f} | {r['precision']:.3f} | {r['recall']:.3f} | "
                      f"{r['fp']} | {r['fn']} |")
     return "\n".join(lines)
 
@@ -136,7 +138,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         p.error(f"unknown variants {bad}; known: {list(VARIANTS)}")
     intents = load_intents(args.intents_from) if args.intents_from else None
     res = run(args.suite, names, lm=args.lm, intents=intents)
-    print(json.dumps(res, indent=1) if args.json else format_table(res))
+    print(dumps(res, indent=1) if args.json else format_table(res))
     return 0
 
 
