@@ -60,9 +60,8 @@ def add_lm_timeout_argument(parser: argparse.ArgumentParser) -> None:
         options = {o for a in p._actions for o in a.option_strings}  # noqa: SLF001
         if "--lm" in options and "--lm-timeout" not in options:
             p.add_argument("--lm-timeout", type=_positive_seconds, default=None, metavar="SECONDS",
-                           help=f"give up on an LM request (retries included) after this long (default: "
-                                f"${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s for servers; in-process "
-                                f"models only when set)")
+                           help=f"give up on a request to an LM server (retries included) after this long "
+                                f"(default: ${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s)")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -124,8 +124,8 @@ DEFAULT_LM_TIMEOUT_S = 120.0
 def lm_timeout_s(default: float | None = DEFAULT_LM_TIMEOUT_S) -> float | None:
     """The request timeout of LM backends in seconds: ``$GIFT_LM_TIMEOUT`` when set, else ``default``.
 
-    A backend that calls a server gives up on a request (retries included) after this long; in-process
-    backends apply it only when it is set explicitly (``default=None``).
+    A backend that calls a server gives up on a request (retries included) after this long. In-process
+    backends (a model in this process) have nothing that can stall and are bounded by ``max_tokens``.
     """
     import os
 

@@ -17,6 +17,9 @@ A suite file::
           - {object: toothbrush, relevant: false, confounds: [lang]}   # lang | vis | unk
         notes: TEXT                    # optional: how the labels were decided
 
+Every intent needs at least one training object, one relevant training object and one test item.
+The file must be UTF-8.
+
 ``appearance`` is optional; a missing one is :data:`gift.core.data.DEFAULT_APPEARANCE` (a grey 8 cm
 cube); a missing ``shape``/``size``/``color`` inside it takes that default's value (for a shape other
 than box, the default size is 4 cm radius and, for a cylinder, 10 cm length).
