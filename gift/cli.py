@@ -88,6 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "run", None):
         parser.print_help()
         return 2
+    previous = os.environ.get(LM_TIMEOUT_ENV)
     if getattr(args, "lm_timeout", None) is not None:  # the environment reaches every worker process too
         os.environ[LM_TIMEOUT_ENV] = repr(args.lm_timeout)
     try:
@@ -101,6 +102,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stderr.close()
         return 0
+    finally:  # main() may be called in-process (tests, scripts): leave the environment as it was
+        if previous is None:
+            os.environ.pop(LM_TIMEOUT_ENV, None)
+        else:
+            os.environ[LM_TIMEOUT_ENV] = previous
     return int(code or 0)
 
 
