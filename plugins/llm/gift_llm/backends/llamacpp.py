@@ -32,7 +32,7 @@ import numpy as np
 
 from gift.core.data import Completion, Message, Usage
 from gift.core.errors import LMError
-from gift.core.interfaces import LMBackend, lm_timeout_s
+from gift.core.interfaces import LMBackend
 from gift_llm.backends.common import first_token_ids, message_dicts, probabilities_from_logits
 
 _MODELS: dict[tuple[str, int], tuple[Any, threading.RLock]] = {}
@@ -96,22 +96,6 @@ def _close_all() -> None:
         _MODELS.clear()
 
 
-class _TimedOut(Exception):
-    pass
-
-
-class _Deadline:
-    """A llama.cpp logits processor that stops generation (raises) once ``deadline`` has passed."""
-
-    def __init__(self, deadline: float) -> None:
-        self.deadline = deadline
-
-    def __call__(self, input_ids: Any, scores: Any) -> Any:
-        if time.perf_counter() > self.deadline:
-            raise _TimedOut
-        return scores
-
-
 class LlamaCppLM(LMBackend):
     """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities).
 
@@ -123,7 +107,7 @@ class LlamaCppLM(LMBackend):
 
     def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int | None = None,
                  n_batch: int = 512, seed: int = 0, reuse_prefix: bool = True, verbose: bool = False,
-                 timeout_s: float | None = None, **_ignored: Any):
+                 **_ignored: Any):
         if model is None:
             from gift_llm.embedded import embedded_model_path
 
@@ -138,9 +122,6 @@ class LlamaCppLM(LMBackend):
         #: Prompt tokens taken from the KV cache in the last :meth:`next_token_logits` call.
         self.last_reused_tokens = 0
         self._opts = dict(n_ctx=self.n_ctx, n_threads=n_threads, n_batch=n_batch, seed=seed, verbose=verbose)
-        #: Seconds a :meth:`complete` may generate for (option, else ``$GIFT_LM_TIMEOUT``, else no limit: an
-        #: in-process call cannot stall on a server, and ``max_tokens`` bounds it).
-        self.timeout_s = lm_timeout_s(default=None) if timeout_s is None else float(timeout_s)
         self._llama: Any = None
         self._lock: threading.RLock | None = None
         self._grammars: dict[str, Any] = {}
@@ -186,15 +167,10 @@ class LlamaCppLM(LMBackend):
         assert self._lock is not None
         t0 = time.perf_counter()
         with self._lock:
-            if self.timeout_s is not None:  # checked before each generated token
-                kwargs["logits_processor"] = _Deadline(time.perf_counter() + self.timeout_s)
             if not self.reuse_prefix:
                 llama.reset()
             try:
                 out = llama.create_chat_completion(**kwargs)
-            except _TimedOut:
-                raise LMError(f"llamacpp {self.model}: no answer within the {self.timeout_s:g} s timeout "
-                              f"(--lm-timeout or $GIFT_LM_TIMEOUT)") from None
             except ValueError as e:  # e.g. prompt longer than the context window
                 raise LMError(f"llamacpp {self.model}: {e} (n_ctx={self.n_ctx}; raise it with n_ctx=...)") from e
         latency = time.perf_counter() - t0

@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 
 from gift.core.data import Completion, Message, Usage
 from gift.core.errors import LMError
-from gift.core.interfaces import LMBackend, lm_timeout_s
+from gift.core.interfaces import LMBackend
 from gift_llm.backends.common import first_token_ids, message_dicts, probabilities_from_logits
 
 _FALLBACK_TEMPLATE = ("{% for m in messages %}{{ m['role'] }}: {{ m['content'] }}\n{% endfor %}"
@@ -31,7 +31,7 @@ class TransformersLM(LMBackend):
     supports_choice_probabilities: ClassVar[bool] = True
 
     def __init__(self, model: str | Path | None = None, *, device: str = "cpu", dtype: str = "float32",
-                 timeout_s: float | None = None, **_ignored: Any):
+                 **_ignored: Any):
         if not model:
             raise LMError("transformers backend: give a local model directory, e.g. --lm transformers:/path/dir")
         self.path = Path(model).expanduser().resolve()
@@ -40,8 +40,6 @@ class TransformersLM(LMBackend):
                           f"(no config.json); models are never downloaded at run time")
         self.model = str(self.path)
         self.device, self.dtype = device, dtype
-        #: Seconds a :meth:`complete` may generate for (option, else ``$GIFT_LM_TIMEOUT``, else no limit).
-        self.timeout_s = lm_timeout_s(default=None) if timeout_s is None else float(timeout_s)
         self._tok: Any = None
         self._lm: Any = None
         self._lock: threading.Lock | None = None
@@ -86,18 +84,12 @@ class TransformersLM(LMBackend):
                                    pad_token_id=tok.pad_token_id if tok.pad_token_id is not None else tok.eos_token_id)
         if temperature > 0:
             gen["temperature"] = float(temperature)
-        if self.timeout_s is not None:
-            gen["max_time"] = self.timeout_s
         t0 = time.perf_counter()
         with lock, torch.no_grad():
             if seed is not None:
                 torch.manual_seed(int(seed))
             out = lm.generate(ids, attention_mask=torch.ones_like(ids), **gen)
         new = out[0, ids.shape[1]:]
-        if (self.timeout_s is not None and time.perf_counter() - t0 >= self.timeout_s and len(new) < max_tokens
-                and (len(new) == 0 or int(new[-1]) != tok.eos_token_id)):  # cut short, not finished
-            raise LMError(f"transformers {self.path.name}: no answer within the {self.timeout_s:g} s timeout "
-                          f"(--lm-timeout or $GIFT_LM_TIMEOUT)")
         text = tok.decode(new, skip_special_tokens=True)
         for s in stop or ():
             if s and s in text:
