@@ -211,7 +211,10 @@ class SQLiteStore:
 
     def _recover(self, error: sqlite3.Error) -> None:
         """The file failed with ``error``: move it aside unless another thread or process already did."""
-        self._local.conn = None
+        conn, self._local.conn = getattr(self._local, "conn", None), None
+        if conn is not None:
+            with contextlib.suppress(sqlite3.Error):
+                conn.close()
         with self._repair_lock():
             problem = self.integrity_problem(full=False)
             if problem is None:
