@@ -633,7 +633,7 @@ def limited(limit: ConcurrencyLimit | None) -> Iterator[None]:
 
 __all__ = [
     "DEFAULT_EXECUTOR", "ConcurrencyLimit", "ExecutionError", "Executor", "ExecutorError", "ItemFailure",
-    "LocalExecutor", "die_with_parent", "RateLimit", "RateLimitedLM", "SerialExecutor", "add_executor_argument", "assemble",
-    "check_picklable", "chunk_bounds", "default_lock_directory", "executor_from_args", "get_executor",
-    "item_seeds", "limited", "run_chunk", "using_executor",
+    "LocalExecutor", "RateLimit", "RateLimitedLM", "SerialExecutor", "add_executor_argument", "assemble",
+    "check_picklable", "chunk_bounds", "default_lock_directory", "die_with_parent", "executor_from_args",
+    "get_executor", "item_seeds", "limited", "run_chunk", "using_executor",
 ]

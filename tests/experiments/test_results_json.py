@@ -100,7 +100,8 @@ def test_cli_json_outputs_are_strict(tmp_path, capsys):
         "intents:\n"
         "  - {id: art, task: pack_backpack, text: pack art supplies, train_objects: [paintbrush, sketchbook, banana],\n"
         "     relevant_train: [paintbrush, sketchbook],\n"
-        "     test: [{object: watercolor set, relevant: true}, {object: toothbrush, relevant: false, confounds: [lang]}]}\n")
+        "     test: [{object: watercolor set, relevant: true},\n"
+        "            {object: toothbrush, relevant: false, confounds: [lang]}]}\n")
     out = tmp_path / "res.json"
     assert main(["evaluate-alignment", "--suite", str(suite), "--kernels", "language", "--threshold", "non-oracle",
                  "--out", str(out), "--json", "--quiet", "--executor", "serial"]) == 0

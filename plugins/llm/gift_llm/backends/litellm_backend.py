@@ -51,7 +51,8 @@ class LiteLLM(LMBackend):
     supports_choice_probabilities: ClassVar[bool] = False
 
     def __init__(self, model: str | None = None, *, api_base: str | None = None, api_key_env: str | None = None,
-                 timeout_s: float | None = None, max_retries: int = 4, backoff_s: float = 1.0, backoff_max_s: float = 30.0,
+                 timeout_s: float | None = None, max_retries: int = 4, backoff_s: float = 1.0,
+                 backoff_max_s: float = 30.0,
                  logprobs: bool | None = None, top_logprobs: int = 20, json_style: str | None = None,
                  **_ignored: Any):
         if not model:
