@@ -148,6 +148,7 @@ def chat_server() -> Iterator[ChatServer]:
 # ----------------------------------------------------------------------------- timeouts
 
 
+@pytest.mark.slow
 def test_a_server_that_never_answers_fails_within_the_timeout():
     from gift_llm.backends.litellm_backend import LiteLLM
 
@@ -188,6 +189,7 @@ def test_retries_are_logged_while_they_happen(caplog):
     assert url in lines[0] and "request timeout left" in lines[0]
 
 
+@pytest.mark.slow
 def test_gift_lm_ask_lm_timeout_gives_a_clear_error_in_time():
     with silent_server() as url:
         t0 = time.monotonic()
@@ -213,6 +215,7 @@ def test_every_command_that_takes_lm_takes_lm_timeout():
 # ----------------------------------------------------------------------------- secrets
 
 
+@pytest.mark.slow
 def test_credentials_in_api_base_reach_no_output_file_or_message(chat_server, tmp_path):
     """One run of every kind with a password and a query key in --api-base; then every byte it left is searched."""
     port = chat_server.server_address[1]
@@ -305,6 +308,7 @@ def test_a_file_that_is_not_a_database_is_moved_aside_and_a_fresh_cache_started(
     assert sqlite3.connect(path).execute("SELECT COUNT(*) FROM entries").fetchone()[0] == 1
 
 
+@pytest.mark.slow
 def test_gift_lm_cache_stats_survives_a_damaged_file_and_repair_checks_a_malformed_one(tmp_path):
     env = {"GIFT_CACHE_DIR": str(tmp_path)}
     path = tmp_path / "lm" / "lm-cache.sqlite"
