@@ -30,7 +30,9 @@ nothing is half-loaded.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+import contextlib
+import gc
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -308,12 +310,31 @@ def read_suite_text(path: str | Path) -> str:
                          f"save the file as UTF-8", path=str(p)) from None
 
 
+@contextlib.contextmanager
+def _gc_paused() -> Iterator[None]:
+    """Pause Python's cyclic garbage collector while a suite is built.
+
+    Building a large document allocates millions of objects, each allocation burst triggers a collection,
+    and each full collection walks every object of the process: the cost grows with the square of the file
+    (a 6.3 MB suite parsed in 28 s with the collector running, 7 s paused). Reference counting still frees
+    everything; the collector resumes afterwards.
+    """
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
 def parse_suite_yaml(text: str, *, path: str = "<memory>", pure_python: bool = False) -> Any:
     """The YAML document of a suite file (duplicate keys are an error). ``pure_python`` forces PyYAML's
     Python parser instead of libyaml's (same result; for comparisons)."""
     loader = _PyStrictLoader if pure_python else _StrictLoader
     try:
-        return yaml.load(text, Loader=loader)  # noqa: S506 - SafeLoader subclasses
+        with _gc_paused():
+            return yaml.load(text, Loader=loader)  # noqa: S506 - SafeLoader subclasses
     except SuiteError as e:
         raise SuiteError(str(e), path=path) from None
     except yaml.YAMLError as e:
@@ -325,8 +346,9 @@ def parse_suite_yaml(text: str, *, path: str = "<memory>", pure_python: bool = F
 def load_suite_file(path: str | Path, *, known_tasks: Iterable[str] | None = None) -> Suite:
     """Load and validate a suite file."""
     p = Path(path)
-    data = parse_suite_yaml(read_suite_text(p), path=str(p))
-    return parse_suite(data, path=str(p), known_tasks=known_tasks)
+    with _gc_paused():
+        data = parse_suite_yaml(read_suite_text(p), path=str(p))
+        return parse_suite(data, path=str(p), known_tasks=known_tasks)
 
 
 def load_suite(name_or_path: str | Path, *, known_tasks: Iterable[str] | None | Callable = "registered") -> Suite:
