@@ -10,6 +10,8 @@ import sys
 from collections.abc import Sequence
 
 from gift.core.errors import GiftError
+from gift.core.interfaces import DEFAULT_LM_TIMEOUT_S, LM_TIMEOUT_ENV
+from gift.core.redaction import redact_text
 from gift.plugins.manager import KINDS, get_manager
 
 
@@ -75,6 +77,36 @@ def configure_logging(verbose: int = 0, quiet: int = 0) -> int:
     return level
 
 
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
+def _parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """``parser`` and every sub-command parser below it."""
+    out = [parser]
+    for action in parser._actions:  # noqa: SLF001 - argparse keeps sub-parsers only there
+        if isinstance(action, argparse._SubParsersAction):  # noqa: SLF001
+            for sub in dict.fromkeys(action.choices.values()):
+                out += _parsers(sub)
+    return out
+
+
+def add_lm_timeout_argument(parser: argparse.ArgumentParser) -> None:
+    """Give every (sub-)command that takes ``--lm`` also ``--lm-timeout SECONDS`` (sets ``$GIFT_LM_TIMEOUT``)."""
+    for p in _parsers(parser):
+        options = {o for a in p._actions for o in a.option_strings}  # noqa: SLF001
+        if "--lm" in options and "--lm-timeout" not in options:
+            p.add_argument("--lm-timeout", type=_positive_seconds, default=None, metavar="SECONDS",
+                           help=f"give up on a request to an LM server (retries included) after this long "
+                                f"(default: ${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="gift", description="Generalizing Intent for Flexible Test-time rewards",
                                      parents=[_verbosity_parser(False)])
@@ -92,6 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
         if configure is not None:
             configure(sp)
         sp.set_defaults(run=comp.factory)
+    add_lm_timeout_argument(parser)
     return parser
 
 
@@ -102,10 +135,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "run", None):
         parser.print_help()
         return 2
+    previous = os.environ.get(LM_TIMEOUT_ENV)
+    if getattr(args, "lm_timeout", None) is not None:  # the environment reaches every worker process too
+        os.environ[LM_TIMEOUT_ENV] = repr(args.lm_timeout)
     try:
         code = args.run(args)
     except GiftError as e:
-        logging.getLogger("gift").error("gift %s: error: %s", args.command, e)
+        logging.getLogger("gift").error("gift %s: error: %s", args.command, redact_text(str(e)))
         return 1
     except KeyboardInterrupt:
         logging.getLogger("gift").error("interrupted")
@@ -113,6 +149,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stderr.close()
         return 0
+    finally:  # main() may be called in-process (tests, scripts): leave the environment as it was
+        if previous is None:
+            os.environ.pop(LM_TIMEOUT_ENV, None)
+        else:
+            os.environ[LM_TIMEOUT_ENV] = previous
     return int(code or 0)
 
 
