@@ -53,6 +53,13 @@ def gift_register_doctor_checks(register):
 
 
 @hookimpl
+def gift_resolve_lm(spec, options):
+    from gift_llm.resolve import resolve_lm
+
+    return resolve_lm(spec, **options)
+
+
+@hookimpl
 def gift_register_commands(register):
     from gift_llm.cli import configure, run
 
