@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     from gift import doctor
 
     d = sub.add_parser("doctor", help="check the install; print what is missing with the command that fixes it",
-                       description=doctor.__doc__.splitlines()[0])
+                       description=doctor.__doc__.splitlines()[0], parents=[common])
     doctor.configure(d)
     d.set_defaults(run=doctor.run)
     for comp in get_manager().components("command"):

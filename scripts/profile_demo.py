@@ -191,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
 
     t0 = time.perf_counter()
     cpu0 = time.process_time()
-    code = gift_main(["demo", "--out", str(out), "--quiet", *args.demo_args])
+    code = gift_main(["demo", "--out", str(out), *args.demo_args])
     total, cpu = time.perf_counter() - t0, time.process_time() - cpu0
     if profiler is not None:
         profiler.stop()
