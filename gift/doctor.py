@@ -22,6 +22,7 @@ from __future__ import annotations
 import importlib
 import importlib.metadata
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -119,8 +120,8 @@ def check_cache_dirs(quick: bool = False) -> list[Check]:
             bad.append(f"{d}: {type(e).__name__}: {e.strerror or e}")
     if bad:
         return [Check("cache directories", "fail", "not writable: " + "; ".join(bad),
-                      f"make them writable, or point GIFT_CACHE_DIR at a writable directory "
-                      f"(now {'GIFT_CACHE_DIR=' + str(root) if root else 'unset'})")]
+                      f"make them writable, or point GIFT_CACHE_DIR at a writable directory (now "
+                      f"{'GIFT_CACHE_DIR=' + os.environ['GIFT_CACHE_DIR'] if os.environ.get('GIFT_CACHE_DIR') else 'unset'})")]
     return [Check("cache directories", "ok", f"{root} ({len(dirs) - 1} sub-directories) writable")]
 
 
