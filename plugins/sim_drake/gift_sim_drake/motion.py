@@ -37,7 +37,7 @@ from gift.core.errors import GiftError
 from gift_sim_drake.features import compute_features, resolve_task
 from gift_sim_drake.plant import CONTAINERS, drake_ik, footprint_radius, half_height
 from gift_sim_drake.robots import RobotSpec
-from gift_sim_drake.scenes import FAMILIES, check_family, nominal_target
+from gift_sim_drake.scenes import FAMILIES, check_family, lift_height, nominal_target
 
 N_STEPS = 61
 GENERATORS = ("preferred", "default", "random")
@@ -98,7 +98,7 @@ def build_actions(scene: Scene) -> ActionSet:
         above = np.array([c[0], c[1], CONTAINERS[mark]["height"] + 0.08])
         targets = []
         for p in pos:
-            lift = np.array([p[0], p[1], max(p[2] + 0.15, 0.25)])
+            lift = np.array([p[0], p[1], lift_height(p[2])])
             transit = np.array([(p[0] + c[0]) / 2, (p[1] + c[1]) / 2, max(lift[2], above[2]) + 0.03])
             grasp = np.array([p[0], p[1], max(p[2], 0.02)])  # thin objects: keep the fingers off the table
             targets.append([grasp + [0, 0, 0.12], grasp, lift, transit, above, c])
