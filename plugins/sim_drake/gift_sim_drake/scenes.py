@@ -9,7 +9,11 @@ demonstration in the scene shows the human doing something the nominal controlle
 - pack_backpack / store_drawer: objects anywhere on the table beside the container, and, given the arm's
   ``reach``, only where it can pick them (the lift above each one within reach, with a margin).
 - sweep_spill: objects in slots on either side of the spill.
-- place_mug: objects along the mug's straight path from its start to its goal.
+- place_mug: objects beside the mug's straight path from its start to its goal, on both sides of it and
+  :data:`MUG_LATERAL` away from it. When the scene has both kinds, the relevant objects lie on one side
+  and the irrelevant ones on the other, so that steering around the relevant objects (what the simulated
+  human does, :class:`gift.tasks.PlaceMug`) takes the mug towards the others rather than away from every
+  object at once; otherwise the objects are split evenly between the sides.
 """
 
 from __future__ import annotations
@@ -27,6 +31,10 @@ FAMILIES = {"pack_backpack": "backpack", "store_drawer": "drawer", "sweep_spill"
 #: Height (m) of the place point inside a container above the table.
 PLACE_HEIGHT = {"backpack": 0.09, "drawer": 0.07}
 MUG_CENTER_Z = MUG.size[1] / 2
+#: place_mug: distance (m) of an object's centre from the mug's straight path, drawn uniformly in this range.
+#: At least half the steer of the low carries (:data:`gift_sim_drake.motion.MUG_STEER`), so that a carry
+#: steered towards an object's side passes closer to it than the straight path, not round its far side.
+MUG_LATERAL = (0.08, 0.14)
 #: The most the pick motion's perturbation raises the lift (m; :meth:`gift_sim_drake.motion.MotionPlanner.perturb`).
 LIFT_JITTER = 0.05
 #: Margin (m) kept inside the arm's reach: the grasp perturbation (1 cm) and the gap between the local-IK reach
@@ -123,7 +131,7 @@ def layout(task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str], se
             raise GiftError(f"a sweep_spill scene holds at most {len(slots)} objects, got {n}")
         pick = rng.permutation(len(slots))[:n]
         xy = s + slots[pick] + rng.uniform(-0.012, 0.012, size=(n, 2))
-    else:  # place_mug: objects along the mug's straight path from start to goal
+    else:  # place_mug: objects beside the mug's straight path, on both sides of it
         sy = rng.choice([-1.0, 1.0])
         start = np.array([0.45 + rng.uniform(-0.03, 0.03), sy * (-0.30 + rng.uniform(-0.03, 0.03))])
         goal = np.array([0.45 + rng.uniform(-0.03, 0.03), sy * (0.30 + rng.uniform(-0.03, 0.03))])
@@ -131,7 +139,12 @@ def layout(task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str], se
         landmarks["mug_goal"] = (float(goal[0]), float(goal[1]), MUG_CENTER_Z)
         along = rng.permutation(np.linspace(0.22, 0.78, n)) if n > 1 else np.array([0.5])
         normal = np.array([-(goal - start)[1], (goal - start)[0]]) / np.linalg.norm(goal - start)
-        lateral = rng.uniform(-0.05, 0.05, size=n) + np.where(np.arange(n) % 2, 1.0, -1.0) * 0.02 * (n > 5)
+        rel = np.array([o.name in set(relevant) for o in objects])
+        if rel.any() and not rel.all():
+            sides = np.where(rel, 1.0, -1.0) * rng.choice([-1.0, 1.0])
+        else:
+            sides = rng.permutation(np.resize([1.0, -1.0], n))
+        lateral = sides * rng.uniform(*MUG_LATERAL, size=n)
         xy = start + along[:, None] * (goal - start) + lateral[:, None] * normal
     positions = np.column_stack([xy, heights])
     # the nominal controller's object should be an irrelevant one when the scene has both kinds
