@@ -150,6 +150,14 @@ class RelevantObjects:
         """Whether the demonstrations split the observed objects into relevant and irrelevant ones."""
         return bool(self.relevant) and bool(self.irrelevant)
 
+    def to_dict(self) -> dict:
+        """A JSON-able summary (for results files): everything but the per-object evidence counts in full."""
+        return {"relevant": list(self.relevant), "scores": {k: float(v) for k, v in self.scores.items()},
+                "cut": self.cut, "rule": self.rule, "unobserved": list(self.unobserved),
+                "undetermined": list(self.undetermined), "modes": dict(self.modes),
+                "informative": self.informative, "scenes": self.scenes,
+                "evidence": {k: attrs.asdict(v) for k, v in self.evidence.items()}}
+
 
 # ----------------------------------------------------------------------------- evidence of one scene
 

@@ -1,8 +1,8 @@
 """The relevant training objects inferred from real Drake demonstrations, one test per task family.
 
 Demonstration pairs are made the way ``gift reproduce`` makes them, at its sizes (4 training scenes of 6
-pairs; ``_placed_scene`` picks each scene's objects from the reproduce seeds) but without the random
-alternatives, which the inference does not read: a few seconds per intent. At 3 scenes of 4 pairs the
+pairs; :func:`gift.study.scenes.training_set` with the study's seeds) but with a single random
+alternative per scene, since the inference does not read them: a few seconds per intent. At 3 scenes of 4 pairs the
 leather wallet of ``leather_goods`` is pushed in a single pair (the belt is the better push in the scenes
 holding both) and its posterior stays at 0.47, so the reduced size would test luck, not the rule.
 :func:`gift.core.demonstrations.infer_relevant_objects` sees only the pairs and the training object names.
@@ -14,16 +14,17 @@ from __future__ import annotations
 import logging
 
 import pytest
-from gift_experiments.reproduce import ReproduceConfig, _placed_scene, _seed, intent_seeds
 
 import gift
 from gift.core.data import DemonstrationPair
 from gift.core.demonstrations import infer_relevant_objects
+from gift.study.chain import StudyConfig, intent_seeds
+from gift.study.scenes import training_set
 
 pytestmark = [pytest.mark.slow, pytest.mark.drake]
 
 ROBOT = "jaco"
-SCENES, PAIRS = ReproduceConfig().train_scenes, ReproduceConfig().demos_per_scene
+SCENES, PAIRS = StudyConfig().train_scenes, StudyConfig().demos_per_scene
 
 
 @pytest.fixture(scope="module")
@@ -35,17 +36,10 @@ def setting():
 def demonstrations(setting, intent_id: str) -> tuple[list[DemonstrationPair], object]:
     suite, sim = setting
     spec = suite.intent(intent_id)
-    specs = gift.get_task(spec.task).feature_specs(spec.train_objects)
-    rel = list(spec.relevant_train)
-    irr = [o for o in spec.train_objects if o not in rel]
-    seeds = intent_seeds(ReproduceConfig(suite="gift-dev", train_scenes=SCENES), intent_id)["train"]
-    pairs = []
-    for k, seed in enumerate(seeds):
-        scene = _placed_scene(sim, suite, spec.task, rel, irr, ReproduceConfig().test_objects_per_scene, seed)
-        pref = sim.features(sim.generate(scene, "preferred", PAIRS, _seed("p", intent_id, k)), spec.task).reindex(specs)
-        dflt = sim.features(sim.generate(scene, "default", PAIRS, _seed("d", intent_id, k)), spec.task).reindex(specs)
-        pairs += [DemonstrationPair(pref.trace(i), dflt.trace(i), scene) for i in range(PAIRS)]
-    return pairs, spec
+    cfg = StudyConfig(suite="gift-dev", train_scenes=SCENES)
+    ts = training_set(sim, gift.get_task(spec.task), suite, spec, seeds=intent_seeds(cfg, intent_id)["train"],
+                      demos=PAIRS, alternatives=1, objects_per_scene=cfg.test_objects_per_scene)
+    return ts.pairs(), spec
 
 
 @pytest.mark.parametrize("intent_id", ["toiletries", "baking_tools", "leather_goods"])

@@ -9,8 +9,8 @@ import pytest
 
 import gift
 from gift.core.errors import PlacementError
-from gift_experiments.reproduce import Components, ReproduceConfig, _placed_scene
-from gift_experiments.reproduce import test_scene as make_test_scene  # not a test
+from gift.study.scenes import place_scene
+from gift.study.scenes import test_scene as make_test_scene  # not a test
 
 pytestmark = [pytest.mark.drake]
 
@@ -25,25 +25,24 @@ def setting():
     spec = suite.intent("reading_material")
     rel = [t.object for t in spec.test if t.relevant]
     irr = [t.object for t in spec.test if not t.relevant]
-    return Components(ReproduceConfig(robot="jaco")), suite, spec, rel, irr
+    return gift.get_simulator("drake-jaco"), suite, spec, rel, irr
 
 
 def test_a_pick_that_does_not_fit_is_replaced_by_the_next_pick_of_the_same_seed(setting):
-    comp, suite, spec, rel, irr = setting
-    sim = comp.simulator("jaco")
+    sim, suite, spec, rel, irr = setting
     with pytest.raises(PlacementError, match="1 random picks of 4 objects"):
-        _placed_scene(sim, suite, spec.task, rel, irr, 4, SEED, attempts=1)
-    scene = make_test_scene(comp, suite, spec, "jaco", SEED)
+        place_scene(sim, suite, spec.task, rel, irr, 4, SEED, attempts=1)
+    scene = make_test_scene(sim, suite, spec, 4, SEED)
     assert len(scene.object_names) == 4
     assert scene.relevant and set(scene.object_names) - set(scene.relevant)
-    assert make_test_scene(comp, suite, spec, "jaco", SEED).object_names == scene.object_names  # deterministic
+    assert make_test_scene(sim, suite, spec, 4, SEED).object_names == scene.object_names  # deterministic
 
 
 # ----------------------------------------------------------------------------- every scene fits, in reach
 
 
 def _rq3_objects(spec) -> list[str]:
-    """The four objects :func:`gift_experiments.reproduce.rq3` places (one relevant and three confounds)."""
+    """The four objects :func:`gift.study.chain.rq3` places (one relevant and three confounds)."""
     rel = [t.object for t in spec.test if t.relevant]
     conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
         [t.object for t in spec.test if not t.relevant]
@@ -59,18 +58,17 @@ def test_every_scene_of_reproduce_is_placed_with_every_action_in_reach(suite_nam
     (before the layout knew the arm's reach, jaco could not pick e.g. the paintbrush of art_supplies at
     (0.60, -0.40) m, the only relevant object of its scene)."""
     logging.getLogger("drake").setLevel(logging.ERROR)
-    from gift_experiments.reproduce import intent_seeds
+    from gift.study.chain import StudyConfig, intent_seeds
 
     suite = gift.load_suite(suite_name)
-    cfg = ReproduceConfig(suite=suite_name, robot=robot)
-    comp = Components(cfg)
-    sim = comp.simulator(robot)
+    cfg = StudyConfig(suite=suite_name, robot=robot)
+    sim = gift.get_simulator(f"drake-{robot}")
     for spec in suite.intents:
         seeds = intent_seeds(cfg, spec.id)
         rel = list(spec.relevant_train)
         irr = [o for o in spec.train_objects if o not in rel]
-        scenes = [_placed_scene(sim, suite, spec.task, rel, irr, cfg.test_objects_per_scene, s) for s in seeds["train"]]
-        scenes += [make_test_scene(comp, suite, spec, robot, s) for s in seeds["rq1"]]
+        scenes = [place_scene(sim, suite, spec.task, rel, irr, cfg.test_objects_per_scene, s) for s in seeds["train"]]
+        scenes += [make_test_scene(sim, suite, spec, cfg.test_objects_per_scene, s) for s in seeds["rq1"]]
         if spec.task in ("pack_backpack", "store_drawer"):
             objects = _rq3_objects(spec)
             relevant = [o for o in objects if o in spec.relevant_test]
