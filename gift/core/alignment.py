@@ -41,7 +41,9 @@ Thresholds (``threshold=``)
   balanced accuracy; ties: the widest gap). No test label is used. Matrix kernels reuse
   ``K(train, train)`` with the diagonal masked; relevance kernels return the scores from their one
   pass. A relevant object with no relevant partner left is not a usable positive. With no positive or
-  no negative left it falls back to ``non-oracle`` and says so in the note.
+  no negative left it falls back to ``non-oracle`` and says so in the note. A relevance kernel whose
+  scores are calibrated probabilities with the training evidence already folded in
+  (``RelevanceScores.cut``, e.g. gift-prob with ``calibration="pooled"``) gives the cut itself: 1/2.
 - ``"oracle"``: the cut that maximises F1 on the labelled test objects (``test_labels``): an upper bound.
 
 f_ω on trajectories
@@ -245,6 +247,8 @@ class AlignmentScores:
     fallbacks: tuple[str, ...] = ()
     #: JSON-able notes of a relevance kernel's pass (e.g. the category asked about, term weights)
     details: Mapping[str, Any] = attrs.field(factory=dict, eq=False)
+    #: the cut a calibrated relevance kernel's probabilities call for (train-calibrated uses it), or None
+    natural_cut: float | None = None
 
     def threshold(self, strategy: str | float, test_labels: Mapping[str, bool] | None = None
                   ) -> tuple[float, str]:
@@ -267,6 +271,9 @@ class AlignmentScores:
                                 "need=('non-oracle',) to score_alignment")
             return self.train_mean, "mean K over training pairs"
         if strategy == "train-calibrated":
+            if self.natural_cut is not None and self.relevant_train:
+                return float(self.natural_cut), ("the kernel's calibrated probabilities (a pooled prior updated with "
+                                                 "the relevant training objects): 1/2")
             if not self.relevant_train:
                 if self.train_mean is None:
                     raise GiftError("the train-calibrated threshold needs the relevant training objects "
@@ -324,7 +331,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
     need = set(need)
     want_train = ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1
     n_fallbacks = len(getattr(kernel, "fallbacks", ()))
-    train_mean = loo_scores = loo_labels = None
+    train_mean = loo_scores = loo_labels = natural_cut = None
     details: dict[str, Any] = {}
     if isinstance(kernel, RelevanceKernel):
         rs = kernel.score(test, train, intent, tuple(relevant_train))
@@ -337,6 +344,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
         aligned = decision
         details = dict(rs.details)
+        natural_cut = rs.cut
         if want_train:
             Ktt = np.where(mask[None, :], train_r[:, None], 0.0)
             train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
@@ -361,7 +369,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
     return AlignmentScores(test=tuple(o.name for o in test), train=tuple(names),
                            relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
                            aligned=aligned, kernel=kname, train_mean=train_mean, loo_scores=loo_scores,
-                           loo_labels=loo_labels, fallbacks=fallbacks, details=details)
+                           loo_labels=loo_labels, fallbacks=fallbacks, details=details, natural_cut=natural_cut)
 
 
 def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:

@@ -289,7 +289,7 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first") -> None:
+                 select: str = "first", calibration: str = "none") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -309,6 +309,17 @@ class GiftProbKernel(RelevanceKernel):
         if select not in SELECT:
             raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
         self.select = select
+        #: ``"none"``: z-scores per intent with reliability weights, the cut placed on the training scores;
+        #: ``"pooled"``: the shipped :class:`~gift_kernels.calibration.TermCalibration`, updated per intent with
+        #: the relevant training objects (cut 1/2); or the path of a calibration file.
+        if calibration != "none" and combine != "language":
+            raise GiftError("gift-prob: calibration needs both terms (combine='language')")
+        if calibration == "none":
+            self.calibration = None
+        else:
+            from gift_kernels.calibration import TermCalibration
+
+            self.calibration = TermCalibration.load(None if calibration == "pooled" else calibration)
         #: ``"text"``: the intent's text names the category; ``"all"``: every motivation and the objects alone
         #: are candidates, and the training objects verify them (:meth:`candidate_goals`).
         self.candidates = candidates
@@ -572,6 +583,14 @@ class GiftProbKernel(RelevanceKernel):
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
         details["terms"]["language"] = {"test": emb[: len(test)].tolist(), "train": emb[len(test):].tolist()}
+        if self.calibration is not None and rel.any() and (~rel).any():
+            X = np.stack([lo, emb], axis=1)
+            cal = self.calibration.update(X[len(test):], rel)
+            details["calibration"] = {"coef": cal.coef.tolist(), "intercept": cal.intercept,
+                                      "pooled_coef": self.calibration.coef.tolist(),
+                                      "pooled_intercept": self.calibration.intercept}
+            p = cal.probability(X)
+            return RelevanceScores(p[: len(test)], p[len(test):], rel, details, cut=0.5)
         ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
         terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
         w = {"lm": 1.0 - self.weight, "language": self.weight}
