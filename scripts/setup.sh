@@ -71,6 +71,21 @@ log "gift core + plugin distributions + test tools"
 "${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake -e plugins/experiments "torch==2.13.0"
 "${PIP[@]}" "pytest==9.2.0" "pytest-benchmark==5.3.1" "hypothesis==6.170.15" "torch==2.13.0"
 
+# --- browser tests (dev/test set): headless Chromium + its driver from the OS, selenium from PyPI. The tests of
+# report.html and of the Meshcat replays open them in a real browser (tests/experiments/test_viewing_browser.py).
+if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    log "apt: chromium chromium-driver"
+    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium chromium-driver >/dev/null; } \
+      || log "WARNING: could not install chromium chromium-driver; the browser tests will fail"
+  else
+    log "WARNING: missing chromium / chromedriver (apt-get install chromium chromium-driver): the browser tests will fail"
+  fi
+fi
+log "selenium (browser tests)"
+"${PIP[@]}" "selenium==4.51.0" "torch==2.13.0"
+# --- end of browser tests
+
 log "docs: mkdocs (Material) + mkdocstrings"
 "${PIP[@]}" "mkdocs-material==9.8.1" "mkdocstrings[python]==1.0.8" "torch==2.13.0"
 

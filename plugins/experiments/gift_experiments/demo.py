@@ -5,8 +5,10 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from gift_experiments.html_report import write_html_report
 from gift_experiments.report import KERNEL_ORDER, write_report
 from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
+from gift_experiments.views import export_views
 
 #: Small sizes. The binary Call-3 kernels (``gift``, ``lm-no-intent``) are left out by default: on the embedded
 #: 1.5B model one Call 3 over ~25 objects takes minutes on 2 cores; add them with ``--kernels``.
@@ -23,6 +25,8 @@ def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("
     elapsed = time.perf_counter() - t0
     results["timing"]["total"] = elapsed
     report = write_report(results, out, command=f"gift demo --intent {intent}")
+    export_views(results, out)  # views/<intent>_{demos,test}.html: Meshcat replays
+    write_html_report(results, out, command=f"gift demo --intent {intent}")
     intent_text = results["intents"][intent]["text"]
     print(f"intent {intent!r}: inferred -> {intent_text!r}")
     print(f"{'kernel':<16} {'win rate':>9} {'F1':>6}")
@@ -30,5 +34,5 @@ def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("
     for k in [k for k in KERNEL_ORDER if k in rq1] + [ORACLE]:
         f1 = rq2.get(k, {}).get("train-calibrated", {}).get("all", {}).get("f1")
         print(f"{k:<16} {rq1[k]['mean']:>9.3f} {'' if f1 is None else f'{f1:.3f}':>6}")
-    print(f"({elapsed:.0f} s; report and figures in {report.parent})")
+    print(f"({elapsed:.0f} s; report.html, report.md, figures and replays in {report.parent})")
     return 0

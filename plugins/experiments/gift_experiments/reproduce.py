@@ -273,7 +273,9 @@ def align_kernel(comp: Components, suite: Suite, spec: IntentSpec, kernel_name: 
         cut, note = cuts[th]
         al = scores.alignment(cut)
         out[th] = {"cut": cut, "note": note, "fallbacks": fallbacks, "mapping": dict(al.mapping),
-                   "scores": dict(al.scores), "metrics": metrics[th]}
+                   "scores": dict(al.scores), "metrics": metrics[th],
+                   "objects": {n: {"decision": float(scores.decision[i]), "match": scores.train[scores.target[i]]
+                                   if scores.train else None} for i, n in enumerate(scores.test)}}
     return out
 
 
@@ -307,7 +309,7 @@ class IntentJob:
 
 
 #: The per-intent slices of the results dictionary, merged in intent order.
-SECTIONS = ("sanity", "rq1", "rq2", "scatter", "rq3", "intents")
+SECTIONS = ("sanity", "rq1", "rq2", "scatter", "rq3", "intents", "alignments")
 #: Per worker process: the components of each config (simulators, kernels, LM), reused across intents.
 _WORKER_COMPONENTS: dict[ReproduceConfig, Components] = {}
 
@@ -448,6 +450,8 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
             aligned.setdefault(kname, {})[th] = (Alignment(r["mapping"], r["scores"], r["cut"], kernel=kname),
                                                  r["metrics"])
             results["rq2"].setdefault(spec.id, {}).setdefault(kname, {})[th] = r["metrics"]
+        results["alignments"].setdefault(spec.id, {})[kname] = {th: {k: v for k, v in r.items() if k != "metrics"}
+                                                                for th, r in d.items()}
         fallbacks = next(iter(d.values()), {}).get("fallbacks")  # the same for every threshold
         if fallbacks:
             errors.append(f"{spec.id}/{kname}: LM answers completed by default: {'; '.join(fallbacks)}")
