@@ -112,6 +112,7 @@ class IntentViews:
     alignment: Alignment | None
     relevant_test: frozenset[str]
     relevant_train: tuple[str, ...]
+    simulator: Any = None  # the simulator that generated the trajectories (replays them too)
 
 
 def _concat(batches):
@@ -176,7 +177,8 @@ def intent_views(results: Mapping[str, Any], out: Path | None, intent: str, kern
         alignment, name = oracle_alignment(spec), rp.ORACLE
     score = np.asarray(reward.score_aligned(feats, alignment), dtype=float)
     return IntentViews(intent, cfg.robot, train_scene, preferred, default, scene, test, score, truth, name,
-                       alignment, frozenset(t.object for t in spec.test if t.relevant), tuple(spec.relevant_train))
+                       alignment, frozenset(t.object for t in spec.test if t.relevant), tuple(spec.relevant_train),
+                       sim)
 
 
 # ----------------------------------------------------------------------------- replays
@@ -208,7 +210,7 @@ def build_replay(views: IntentViews, which: str, simulator=None, meshcat=None, p
 
     if which not in VIEWS:
         raise GiftError(f"unknown view {which!r}; views: {', '.join(VIEWS)}")
-    sim = simulator or gift.get_simulator(f"drake-{views.robot}")
+    sim = simulator or views.simulator or gift.get_simulator(f"drake-{views.robot}")
     if which == "demos":
         scene = views.train_scene
         clips = []

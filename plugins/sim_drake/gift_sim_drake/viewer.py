@@ -114,8 +114,8 @@ def _caption_panel(replay: Replay) -> str:
     segments = json.dumps([[s.start_s, s.end_s] for s in replay.segments])
     return f"""<div id="gift-caption">
 <style>
-#gift-caption {{ position: absolute; left: 8px; top: 8px; max-width: 44em; max-height: 45vh; overflow: auto;
-  background: rgba(255, 255, 255, 0.92); font: 13px/1.35 sans-serif; padding: 6px 10px; border-radius: 4px;
+#gift-caption {{ position: absolute; left: 8px; bottom: 8px; max-width: 36em; max-height: 45vh; overflow: auto;
+  background: rgba(255, 255, 255, 0.9); font: 12px/1.3 sans-serif; padding: 6px 10px; border-radius: 4px;
   box-shadow: 0 1px 4px rgba(0, 0, 0, 0.3); z-index: 10; }}
 #gift-caption h1 {{ font-size: 14px; margin: 0 0 4px 0; }}
 #gift-caption ul {{ margin: 2px 0; padding-left: 18px; }}
