@@ -350,7 +350,7 @@ class Report:
             block = (al[k].get(self.threshold) or next(iter(al[k].values()), {})) if al[k] else {}
             head.append(f'{esc(k)}<br><small>cut {_num(block.get("cut"))}</small>')
         rows = []
-        specs = {o.name: o for o in self.suite.specs([n for n, _, _ in objects])} if self.suite is not None else {}
+        specs = {o.name: o for o in self.suite.specs([n for n, _, _ in objects])} if spec is not None else {}
         for i, (name, rel, conf) in enumerate(objects, 1):
             imgs = self.thumbs(specs[name]) if name in specs else []
             pics = "".join(f'<img src="{u}" alt="{esc(name)}, view {v + 1}" width="{THUMB_PX}" height="{THUMB_PX}">'
