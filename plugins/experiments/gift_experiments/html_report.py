@@ -487,7 +487,9 @@ class Report:
                                    "call, or was not run by gift demo / gift reproduce.")
         calls = read_calls(self.lm_record)
         if not calls:
-            return head + "<p>The run made no LM call (every answer came from the stage cache of an earlier run).</p>"
+            why = ("its answers came from the stage cache of an earlier run" if usage else
+                   "no stage of it needed an LM, or its answers came from the stage cache of an earlier run")
+            return head + f"<p>This invocation made no LM call: {why}.</p>"
         hits = sum(c.cached is True for c in calls)
         misses = sum(c.cached is False for c in calls)
         tok = sum((c.prompt_tokens or 0) + (c.completion_tokens or 0) for c in calls)
@@ -598,6 +600,7 @@ svg .label { font-size: 11px; fill: #222; } svg .title { font-size: 12px; font-w
 svg .ref { stroke: #888; stroke-dasharray: 4 3; } svg .err { stroke: #222; } svg .strip { stroke: #ccc; }
 svg .cut { stroke: #000; stroke-width: 2; } svg .pt { stroke: #fff; stroke-width: 1; cursor: pointer; }
 svg .pt:hover, svg .bar:hover { stroke: #000; stroke-width: 2; }
+svg .err, svg .ref, svg .grid, svg .strip, svg .frame, svg text { pointer-events: none; }
 #tip { position: fixed; pointer-events: none; background: #222; color: #fff; padding: 4px 8px; border-radius: 4px;
   font-size: 12px; max-width: 420px; display: none; z-index: 5; }
 details { margin: 4px 0; } summary { cursor: pointer; }
