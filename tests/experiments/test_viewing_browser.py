@@ -42,7 +42,7 @@ def _spec(cfg):
 def test_report_html_has_every_section_and_object_row(viewing_run, browser, tmp_path_factory):
     from selenium.webdriver.common.by import By
 
-    cfg, out, results, seconds = viewing_run
+    cfg, out, results, _ = viewing_run
     open_page(browser, out / "report.html")
     ids = {e.get_attribute("id") for e in browser.find_elements(By.CSS_SELECTOR, "section")}
     assert {"run", "headline", f"intent-{INTENT}", "views", "rq3", "sanity", "lm-calls", "failures", "timing",
@@ -62,8 +62,9 @@ def test_report_html_has_every_section_and_object_row(viewing_run, browser, tmp_
     rows = browser.find_elements(By.CSS_SELECTOR, f"#intent-{INTENT} tr.object-row")
     assert [r.get_attribute("data-object") for r in rows] == [t.object for t in spec.test]
     head = browser.find_element(By.CSS_SELECTOR, f"#intent-{INTENT} table.objects thead").text
+    records = results["alignment"][INTENT]
     for k in cfg.kernels:
-        cut = results["alignments"][INTENT][k]["train-calibrated"]["cut"]
+        cut = records[k]["thresholds"]["train-calibrated"]["cut"]
         assert k in head and f"cut {cut:.3f}" in head
     for row, t in zip(rows, spec.test):
         imgs = row.find_elements(By.CSS_SELECTOR, ".renders img")
@@ -73,9 +74,8 @@ def test_report_html_has_every_section_and_object_row(viewing_run, browser, tmp_
         cells = row.find_elements(By.CSS_SELECTOR, "td")
         assert ("not relevant" if not t.relevant else "relevant") in cells[3].text
         for k, cell in zip(cfg.kernels, cells[4:]):
-            block = results["alignments"][INTENT][k]["train-calibrated"]
-            target = block["mapping"][t.object]
-            assert f"{block['objects'][t.object]['decision']:.3f}" in cell.text
+            target = records[k]["thresholds"]["train-calibrated"]["mapping"][t.object]
+            assert f"{records[k]['objects'][t.object]['decision']:.3f}" in cell.text
             assert (f"→ {target}" if target != DISTRACTOR else "distractor") in cell.text
     # links to the replays, which exist
     links = [a.get_attribute("href") for a in browser.find_elements(By.CSS_SELECTOR, "#views a")]
@@ -172,7 +172,7 @@ def _wait_for(driver, names, timeout=60.0) -> list[str]:
 
 @pytest.mark.parametrize("view", ["test", "demos"])
 def test_meshcat_export_holds_the_robot_and_plays_offline(viewing_run, browser, tmp_path_factory, view):
-    cfg, out, results, seconds = viewing_run
+    cfg, out, results, _ = viewing_run
     index = {e["view"]: e for e in json.loads((out / "views" / "index.json").read_text()) if e["intent"] == INTENT}
     entry = index[view]
     assert "error" not in entry

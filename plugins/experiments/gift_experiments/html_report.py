@@ -3,9 +3,10 @@ image is a data URI, every plot inline SVG, the only script inline; nothing is f
 
 Built from ``results.json`` and the output folder alone, so ``gift report OUT`` regenerates it later:
 
-- ``results.json`` (see :mod:`gift_experiments.report`): configuration, manifest, RQ1-RQ3, intents, errors, and
-  per intent and kernel the alignment of every test object (``alignments``; older runs: read from the
-  stage cache ``stages/<config key>/align-<intent>-<kernel>.json`` when it is there);
+- ``results.json`` (see :mod:`gift_experiments.report`): configuration, manifest, RQ1-RQ3, intents, the
+  relevant training objects, errors, and per intent and kernel the alignment of every test object
+  (``alignment``; runs made before the study layer: read from their stage cache
+  ``stages/<config key>/align-<intent>-<kernel>.json`` when it is there);
 - ``lm_calls.jsonl``: the LM calls of the run (:mod:`gift_experiments.lm_calls`);
 - ``views/index.json``: the Meshcat pages of :mod:`gift_experiments.views`;
 - ``renders/``: object thumbnails (JPEG, three views), made from the simulator's ``render_object`` the first
@@ -37,7 +38,7 @@ from gift.core.data import DISTRACTOR
 from gift_experiments.lm_calls import LM_CALLS, LMCall, read_calls
 from gift_experiments.report import KERNEL_ORDER, SUBSET_LABEL
 from gift_experiments.svg_plots import Point, StripRow, bar_chart, esc, scatter, strips
-from gift_experiments.views import load_alignments, main_threshold
+from gift_experiments.views import load_alignments, main_threshold, relevant_training
 
 log = logging.getLogger(__name__)
 
@@ -167,7 +168,7 @@ class Report:
 
     def intents(self) -> list[str]:
         seen: dict[str, None] = {}
-        for sec in ("intents", "rq1", "rq2", "alignments", "scatter"):
+        for sec in ("intents", "rq1", "rq2", "alignment", "scatter"):
             seen.update(dict.fromkeys(self.r.get(sec) or {}))
         return list(seen)
 
@@ -186,11 +187,22 @@ class Report:
             rows.append(("threshold shown", esc(self.threshold)))
         lm = m.get("lm") or {}
         if lm:
-            rows.append(("LM", esc(lm.get("identity", "")) + (f" (sha256 <code>{esc(lm['sha256'][:16])}…</code>)"
-                                                            if lm.get("sha256") else "")))
-        for k in ("git_commit", "commit", "suite_hash", "config_key", "python", "platform"):
-            if m.get(k):
+            sha = lm.get("model_sha256") or lm.get("sha256")
+            rows.append(("LM", esc(lm.get("identity", "")) + (f" (model sha256 <code>{esc(sha[:16])}…</code>)"
+                                                            if sha else "")))
+        git = m.get("git")
+        if isinstance(git, Mapping) and git.get("commit"):
+            rows.append(("git commit", f"<code>{esc(git['commit'][:12])}</code>" + (" (with uncommitted changes)"
+                                                                                  if git.get("dirty") else "")))
+        suite = m.get("suite")
+        if isinstance(suite, Mapping) and suite.get("sha256"):
+            rows.append(("suite file", f"{esc(suite.get('path') or suite.get('name', ''))} (sha256 "
+                                       f"<code>{esc(suite['sha256'][:16])}…</code>)"))
+        for k in ("code_version", "config_key", "python", "platform"):
+            if m.get(k) and not isinstance(m[k], (Mapping, list)):
                 rows.append((k, f"<code>{esc(m[k])}</code>"))
+        if len(m.get("runs") or []) > 1:
+            rows.append(("runs", f"{len(m['runs'])} (a first run and its resumes)"))
         total = (self.r.get("timing") or {}).get("total")
         if total is not None:
             rows.append(("time", f"{total:.0f} s"))
@@ -261,8 +273,14 @@ class Report:
         out = []
         if spec is not None:
             out.append(f'<p class="task">Task <code>{esc(spec.task)}</code>; training objects: '
-                       f"{esc(', '.join(spec.train_objects))} (the human cares about "
+                       f"{esc(', '.join(spec.train_objects))} (the suite's human cares about "
                        f"{esc(', '.join(spec.relevant_train) or 'none')}).</p>")
+        rel = (self.r.get("relevant") or {}).get(intent)
+        if isinstance(rel, Mapping) and rel.get("names") is not None:
+            src = {"demonstrations": "inferred from the demonstrations", "suite": "the suite's labels"}.get(
+                rel.get("source"), esc(rel.get("source", "")))
+            out.append(f'<p class="relevant">Relevant training objects the run used ({src}): '
+                       f"<b>{esc(', '.join(rel['names']) or 'none')}</b></p>")
         if not d:
             out.append(_missing("No intent recorded for this intent in results.json."))
         else:
@@ -344,7 +362,8 @@ class Report:
             return _missing("No test objects recorded for this intent.")
         kernels = _kernels({"x": al})
         spec = self._spec(intent)
-        relevant_train = set(spec.relevant_train) if spec is not None else None
+        rel_names = relevant_training(self.r, intent, spec)
+        relevant_train = set(rel_names) if rel_names is not None else None
         head = ["#", "object", "renders", "label"]
         for k in kernels:
             block = (al[k].get(self.threshold) or next(iter(al[k].values()), {})) if al[k] else {}
@@ -383,6 +402,8 @@ class Report:
         if score is None:
             score, kind = (block.get("scores") or {}).get(name), "K at the match"
         aligned = target != DISTRACTOR
+        if block.get("relevant_train") is not None:  # what the kernel was told (the study records it)
+            relevant_train = set(block["relevant_train"])
         predicted = aligned and (relevant_train is None or target in relevant_train)
         ok = None if rel is None else predicted == rel
         cls = "" if ok is None else (' class="ok"' if ok else ' class="bad"')

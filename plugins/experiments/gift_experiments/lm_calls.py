@@ -2,7 +2,8 @@
 (the same file ``--lm replay:out/lm_calls.jsonl`` replays), read back for the HTML report.
 
 :func:`recording` sets ``GIFT_LM_RECORD`` for the duration of a command (unless the user set it already,
-then that file is used), so every LM the run resolves records its calls, in worker processes too.
+then that file is used) and makes the study resolve its LM again, so every LM the run uses records its
+calls, in worker processes too.
 The file holds the calls of the last invocation: stages resumed from ``out/stages`` make none.
 """
 
@@ -17,6 +18,8 @@ from pathlib import Path
 from typing import Any
 
 import attrs
+
+from gift.study.components import reset_components
 
 log = logging.getLogger(__name__)
 
@@ -43,11 +46,13 @@ def recording(out: Path, lm: str | None = None) -> Iterator[Path]:
         return
     path.write_text("")
     os.environ[ENV] = str(path)
+    reset_components()  # the study's LM is resolved again, now wrapped by the recorder
     try:
         yield path
     finally:
         if os.environ.get(ENV) == str(path):
             del os.environ[ENV]
+        reset_components()  # and not recorded into this file any more
 
 
 @attrs.frozen

@@ -1,4 +1,4 @@
-"""What ``gift view`` replays of a run, in Drake's Meshcat (:mod:`gift_sim_drake.viewer`).
+"""What ``gift view`` replays of a study run, in Drake's Meshcat (:mod:`gift_sim_drake.viewer`).
 
 Two views per intent of a ``gift demo`` / ``gift reproduce`` output folder:
 
@@ -9,10 +9,10 @@ Two views per intent of a ``gift demo`` / ``gift reproduce`` output folder:
   worst-scored of the scene's test trajectories under the aligned reward R_θ(f_ω(ξ')).
 
 Scenes and trajectories are regenerated from ``results.json`` (configuration, suite, the seeds derived from
-the intent id): the simulator is deterministic, so they are the ones the run used; in the process that
-just ran the experiment Drake's IK cache makes this take a second or two. The reward is refitted on the
-run's training data (MaxEnt IRL, deterministic). The alignment is read from ``results["alignments"]``, or
-for older runs from the stage cache ``out/stages/<config key>/align-<intent>-<kernel>.json``.
+the intent id) by the functions of :mod:`gift.study` that made them: the simulator is deterministic, so
+they are the ones the run used; in the process that just ran the study Drake's IK cache makes this take
+a second or two. The reward is refitted on the run's training set (MaxEnt IRL, deterministic). The
+alignment is the run's record in ``results["alignment"]``.
 
 :func:`export_views` writes ``out/views/<intent>_<view>.html`` (self-contained Meshcat pages) and
 ``out/views/index.json`` (what was written, or why a view failed); ``gift demo`` and ``gift reproduce``
@@ -50,14 +50,14 @@ DISTRACTOR_RGB = (0.3, 0.3, 0.3)
 
 
 def run_config(results: Mapping[str, Any]):
-    """The :class:`~gift_experiments.reproduce.ReproduceConfig` of a results dictionary (unknown keys dropped)."""
-    from gift_experiments.reproduce import ReproduceConfig
+    """The :class:`~gift.study.chain.StudyConfig` of a results dictionary (unknown keys dropped)."""
+    from gift.study.chain import StudyConfig
 
     cfg = results.get("config") or {}
     if not cfg:
         raise GiftError("results.json has no 'config' section: cannot regenerate the run's scenes")
-    names = {f.name for f in attrs.fields(ReproduceConfig)}
-    return ReproduceConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in cfg.items() if k in names})
+    names = {f.name for f in attrs.fields(StudyConfig)}
+    return StudyConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in cfg.items() if k in names})
 
 
 def main_threshold(results: Mapping[str, Any]) -> str | None:
@@ -66,9 +66,15 @@ def main_threshold(results: Mapping[str, Any]) -> str | None:
 
 
 def load_alignments(results: Mapping[str, Any], out: Path | None, intent: str) -> dict[str, dict[str, dict]]:
-    """``{kernel: {threshold: {"cut", "note", "mapping", "scores", "objects"?, "fallbacks"?}}}`` of one intent:
-    from ``results["alignments"]``, else from the run's stage cache in ``out`` (empty when neither has it)."""
-    found = dict(((results.get("alignments") or {}).get(intent)) or {})
+    """``{kernel: {threshold: {"cut", "note", "mapping", "scores", "objects"?, "fallbacks"?, "relevant_train"?}}}``
+    of one intent: from ``results["alignment"]`` (the study's records), else, for runs made before it,
+    from the old stage cache ``out/stages/<config key>/align-<intent>-<kernel>.json`` (empty when neither)."""
+    found: dict[str, dict[str, dict]] = {}
+    for kernel, rec in (((results.get("alignment") or {}).get(intent)) or {}).items():
+        if not isinstance(rec, Mapping) or not isinstance(rec.get("thresholds"), Mapping):
+            continue
+        shared = {k: rec[k] for k in ("objects", "fallbacks", "relevant_train", "details") if k in rec}
+        found[kernel] = {th: {**shared, **block} for th, block in rec["thresholds"].items()}
     key = (results.get("manifest") or {}).get("config_key")
     if out is not None and key:
         stages = Path(out) / "stages" / key
@@ -82,14 +88,25 @@ def load_alignments(results: Mapping[str, Any], out: Path | None, intent: str) -
     return found
 
 
+def relevant_training(results: Mapping[str, Any], intent: str, spec=None) -> tuple[str, ...] | None:
+    """The training objects the run treated as relevant (inferred from the demonstrations, or the suite's)."""
+    rel = ((results.get("relevant") or {}).get(intent) or {}).get("names")
+    if rel is not None:
+        return tuple(rel)
+    return tuple(spec.relevant_train) if spec is not None else None
+
+
 def pick_kernel(alignments: Mapping[str, Any], kernel: str | None = None) -> str:
+    from gift.study.components import parse_spec
+
     if kernel is not None:
         if kernel not in alignments:
             raise GiftError(f"no alignment of kernel {kernel!r} in this run; it has {sorted(alignments) or 'none'}")
         return kernel
+    by_name = {parse_spec(k)[0]: k for k in sorted(alignments, reverse=True)}
     for k in KERNEL_PREFERENCE:
-        if k in alignments:
-            return k
+        if k in by_name:
+            return by_name[k]
     if alignments:
         return sorted(alignments)[0]
     raise GiftError("this run recorded no alignment (no kernel finished, or results.json predates them)")
@@ -97,17 +114,22 @@ def pick_kernel(alignments: Mapping[str, Any], kernel: str | None = None) -> str
 
 @attrs.frozen
 class IntentViews:
-    """The regenerated material of one intent: scenes, trajectories, reward, alignment."""
+    """The regenerated material of one intent: scenes, trajectories, reward, alignment.
+
+    ``preferred`` / ``default``: the demonstrations of the first training scene (None when the run used
+    saved demonstrations, which hold features only); ``test``: the preferred, default and random
+    trajectories of the first RQ1 test scene with ``aligned_score`` ``[N]`` (R_θ(f_ω(ξ'))) and
+    ``true_reward`` ``[N]`` (the task's ground truth for the scene's relevant objects)."""
 
     intent: str
     robot: str
     train_scene: Any
-    preferred: Any  # TrajectoryBatch
-    default: Any  # TrajectoryBatch
+    preferred: Any
+    default: Any
     test_scene: Any
-    test: Any  # TrajectoryBatch: preferred, default, random trajectories of the test scene
-    aligned_score: np.ndarray  # [N] R_θ(f_ω(ξ')) of ``test``
-    true_reward: np.ndarray  # [N] the task's ground-truth reward of ``test`` for the scene's relevant objects
+    test: Any
+    aligned_score: np.ndarray
+    true_reward: np.ndarray
     kernel: str | None
     alignment: Alignment | None
     relevant_test: frozenset[str]
@@ -131,39 +153,37 @@ def _concat(batches):
 
 def intent_views(results: Mapping[str, Any], out: Path | None, intent: str, kernel: str | None = None,
                  components=None) -> IntentViews:
-    """Regenerate one intent's first training scene (with its demonstrations) and first test scene (with
-    its trajectories scored by the reward aligned under ``kernel``; default: :data:`KERNEL_PREFERENCE`)."""
-    from gift_experiments import reproduce as rp
+    """Regenerate one intent's first training scene (with its demonstrations) and first RQ1 test scene (with
+    its trajectories scored by the reward aligned under ``kernel``; default: :data:`KERNEL_PREFERENCE`),
+    as :mod:`gift.study.chain` made them (same seeds, same generators)."""
+    from gift.study.chain import ORACLE, get_training, intent_seeds, oracle_alignment, simulator_name
+    from gift.study.components import Components
+    from gift.study.scenes import stable_seed, test_scene
 
     cfg = run_config(results)
     suite = gift.load_suite(cfg.suite)
     spec = suite.intent(intent)
-    comp = components or rp.Components(cfg)
-    sim = comp.simulator(cfg.robot)
-    seeds = rp.intent_seeds(cfg, spec.id)
-    rel = list(spec.relevant_train)
-    irr = [o for o in spec.train_objects if o not in rel]
-    # the run's first training scene and its demonstrations (as in reproduce.training_data, scene 0)
-    train_scene = rp._placed_scene(sim, suite, spec.task, rel, irr, cfg.test_objects_per_scene, seeds["train"][0])
-    preferred = sim.generate(train_scene, "preferred", cfg.demos_per_scene, rp._seed("p", spec.id, 0))
-    default = sim.generate(train_scene, "default", cfg.demos_per_scene, rp._seed("d", spec.id, 0))
-    demos, alts, _, _ = rp.training_data(comp, suite, spec, cfg.robot, seeds["train"])
-    reward = gift.get_reward_model(cfg.reward).fit(demos, alts)
-    # the run's first RQ1 test scene and its trajectories (as in reproduce.run_intent)
-    seed = seeds["rq1"][0]
-    scene = rp.test_scene(comp, suite, spec, cfg.robot, seed)
-    task = gift.get_task(spec.task)
+    comp = components or Components(cfg.lm, cfg.defaults)
+    sim = comp.simulator(simulator_name(cfg.robot))
+    task = comp.task(spec.task)
+    seeds = intent_seeds(cfg, spec.id)
+    training = get_training(comp, cfg, suite, spec, seeds["train"])
+    reward = comp.reward(cfg.reward).fit(training.demonstrations, training.alternatives)
+    train_scene, preferred, default = training.scenes[0], None, None
+    if not cfg.demonstrations:  # the first training scene's demonstrations, as scenes.training_set drew them
+        preferred = sim.generate(train_scene, "preferred", cfg.demos_per_scene, stable_seed("p", spec.id, 0))
+        default = sim.generate(train_scene, "default", cfg.demos_per_scene, stable_seed("d", spec.id, 0))
+    seed = seeds["rq1"][0]  # the first RQ1 test scene and its trajectories, as chain.win_rates drew them
+    scene = test_scene(sim, suite, spec, cfg.test_objects_per_scene, seed)
     specs = task.feature_specs(scene.object_names)
     batches = []
     for g in ("preferred", "default", "random"):
-        b = sim.generate(scene, g, cfg.trajectories_per_generator, rp._seed(seed, g))
+        b = sim.generate(scene, g, cfg.trajectories_per_generator, stable_seed(seed, g))
         batches.append(attrs.evolve(b, meta={**b.meta, "generator": g}))
     test = _concat(batches)
-    feats: FeatureBatch = FeatureBatch.concat([rp._features(sim, b, spec.task, specs) for b in batches])
+    feats = FeatureBatch.concat([sim.features(b, spec.task).reindex(specs) for b in batches])
     truth = np.asarray(task.ground_truth_reward(feats, sorted(scene.relevant)), dtype=float)
     alignments = load_alignments(results, out, intent)
-    alignment = None
-    name = None
     th = main_threshold(results)
     if alignments:
         name = pick_kernel(alignments, kernel)
@@ -171,14 +191,12 @@ def intent_views(results: Mapping[str, Any], out: Path | None, intent: str, kern
         alignment = Alignment(block["mapping"], block.get("scores", {}), block.get("cut"), kernel=name)
     elif kernel is not None:
         raise GiftError(f"no alignment of kernel {kernel!r} in this run")
-    if alignment is None:
-        from gift_experiments.reproduce import oracle_alignment
-
-        alignment, name = oracle_alignment(spec), rp.ORACLE
+    else:
+        alignment, name = oracle_alignment(spec), ORACLE
     score = np.asarray(reward.score_aligned(feats, alignment), dtype=float)
     return IntentViews(intent, cfg.robot, train_scene, preferred, default, scene, test, score, truth, name,
-                       alignment, frozenset(t.object for t in spec.test if t.relevant), tuple(spec.relevant_train),
-                       sim)
+                       alignment, frozenset(t.object for t in spec.test if t.relevant),
+                       relevant_training(results, intent, spec) or (), sim)
 
 
 # ----------------------------------------------------------------------------- replays
@@ -210,8 +228,14 @@ def build_replay(views: IntentViews, which: str, simulator=None, meshcat=None, p
 
     if which not in VIEWS:
         raise GiftError(f"unknown view {which!r}; views: {', '.join(VIEWS)}")
-    sim = simulator or views.simulator or gift.get_simulator(f"drake-{views.robot}")
+    sim = simulator or views.simulator
+    if not callable(getattr(sim, "replay", None)):
+        raise GiftError(f"the simulator of robot {views.robot!r} ({type(sim).__name__}) cannot replay trajectories "
+                        "(it has no replay method; the Drake simulators have one)")
     if which == "demos":
+        if views.preferred is None:
+            raise GiftError(f"{views.intent}: the run used saved demonstrations (features only): there are no "
+                            "demonstration trajectories to replay; --show test still works")
         scene = views.train_scene
         clips = []
         for i in range(min(pairs, len(views.preferred), len(views.default))):
