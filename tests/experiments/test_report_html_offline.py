@@ -114,3 +114,15 @@ def test_recording_sets_the_record_file_for_the_block_only(tmp_path, monkeypatch
     monkeypatch.setenv("GIFT_LM_RECORD", str(tmp_path / "mine.jsonl"))
     with recording(out) as p:
         assert p == tmp_path / "mine.jsonl" and path.read_text() == '{"recorded": 1}\n'
+
+
+def test_undefined_numbers_of_strict_json_show_as_missing(tmp_path):
+    """results.json writes an undefined number (a one-class subset's AUC, an empty mean) as null."""
+    from test_results_json import results_with_undefined_numbers
+
+    from gift.core.serialization import to_jsonable
+
+    results = to_jsonable(results_with_undefined_numbers(), nonfinite="null")
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert 'class="section-error"' not in page and "–" in page
+    assert 'data-plot="win-rate"' in page

@@ -66,6 +66,11 @@ def _kernels(block: Mapping[str, Mapping[str, Any]]) -> list[str]:
         ([ORACLE] if ORACLE in names else [])
 
 
+def _finite(values) -> list[float]:
+    """The defined numbers of ``values`` (results.json writes an undefined one as null)."""
+    return [float(v) for v in values if isinstance(v, (int, float)) and math.isfinite(v)]
+
+
 def _missing(what: str) -> str:
     return f'<p class="missing">{esc(what)}</p>'
 
@@ -224,12 +229,13 @@ class Report:
         head = ["kernel", "win rate (mean over intents ± s.e.)"] + [f"F1, {esc(t)} threshold" for t in ths]
         rows = []
         for k in kernels:
-            wr = [per[k]["mean"] for per in rq1.values() if k in per]
+            wr = _finite(per[k].get("mean") for per in rq1.values() if k in per)
             se = float(np.std(wr, ddof=1) / np.sqrt(len(wr))) if len(wr) > 1 else None
             cells = [f'<span class="swatch" style="background:{_colour(k)}"></span>{esc(k)}',
                      (_num(float(np.mean(wr))) + (f" ± {se:.3f}" if se is not None else "")) if wr else "–"]
             for t in ths:
-                f1 = [per[k][t]["all"]["f1"] for per in rq2.values() if "all" in (per.get(k) or {}).get(t, {})]
+                f1 = _finite(per[k][t]["all"].get("f1") for per in rq2.values()
+                             if "all" in (per.get(k) or {}).get(t, {}))
                 cells.append(_num(float(np.mean(f1))) if f1 else "–")
             rows.append(cells)
         note = (f"<p>{len(rq1) or len(rq2)} intent(s). Win rate: RQ1 pairwise win rate of the aligned reward on test "
