@@ -18,6 +18,9 @@ ROOT=$PWD
 # Each entry: "<lib:shared library | cmd:command that must exist>=<Debian packages providing it>".
 APT_USER=("lib:libEGL_mesa.so.0=libegl1 libegl-mesa0")  # EGL (Mesa): Drake's headless renders (vision kernel)
 APT_DEV=("cmd:redis-server=redis-server")               # the Redis LM-cache tests start their own server
+# Browser tests (report.html, Meshcat replays; tests/experiments/test_viewing_browser.py): headless Chromium
+# and its driver from the OS; selenium comes with gift's [test] extra.
+APT_DEV+=("cmd:chromium=chromium" "cmd:chromedriver=chromium-driver")
 # gift's distributions, editable, with the extras each set needs (the extras are declared in each
 # pyproject.toml). The dev set is installed on top of the user set.
 PIP_USER=(-e . -e "plugins/llm[llamacpp,embedded,litellm]" -e "plugins/kernels[embeddings]"

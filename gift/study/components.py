@@ -150,3 +150,10 @@ def components_for(lm: Any = None, defaults: Mapping[str, Any] | None = None) ->
         if key not in _WORKER:
             _WORKER[key] = Components(lm, defaults)
         return _WORKER[key]
+
+
+def reset_components() -> None:
+    """Forget this process's :class:`Components` (the next study builds its components, and resolves its LM,
+    again): for a change of the environment that decides how the LM is wrapped, e.g. ``GIFT_LM_RECORD``."""
+    with _WORKER_LOCK:
+        _WORKER.clear()

@@ -10,40 +10,16 @@ import subprocess
 import attrs
 import numpy as np
 import pytest
-import yaml
 
-import gift
 from gift.study.chain import ORACLE, StudyConfig
 from gift.study.progress import Progress
 from gift.study.sweeps import run_study
 from gift_experiments.report import headline_table, write_report
+from mini_suite import N_TEST, mini_suite
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm, pytest.mark.drake]
 
 KERNELS = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
-
-
-N_TEST = 8
-
-
-def mini_suite(path):
-    """The `valuables` intent of gift-paper with 8 of its test objects (4 relevant, 4 not, confounds first)."""
-    suite = gift.load_suite("gift-paper")
-    spec = suite.intent("valuables")
-    rel = [t for t in spec.test if t.relevant][: N_TEST // 2]
-    irr = sorted((t for t in spec.test if not t.relevant), key=lambda t: not t.confounds)[: N_TEST // 2]
-    names = list(spec.train_objects) + [t.object for t in rel + irr]
-    doc = {"suite": "mini-valuables",
-           "objects": {n: {"description": suite.objects[n].description,
-                           "appearance": {"shape": suite.objects[n].appearance.shape,
-                                          "size": list(suite.objects[n].appearance.size),
-                                          "color": list(suite.objects[n].appearance.color)}} for n in names},
-           "intents": [{"id": "valuables", "task": spec.task, "text": spec.text,
-                        "train_objects": list(spec.train_objects), "relevant_train": list(spec.relevant_train),
-                        "test": [{"object": t.object, "relevant": t.relevant, "confounds": list(t.confounds)}
-                                 for t in rel + irr]}]}
-    path.write_text(yaml.safe_dump(doc, sort_keys=False))
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -47,3 +47,24 @@ def test_call_not_in_the_recording_is_a_clear_error(tmp_path):
     rec.write_text("not json\n")
     with pytest.raises(LMError, match="line 1"):
         ReplayLM(rec)
+
+
+def test_recording_says_whether_the_cache_answered(tmp_path):
+    """Control flow of the record's ``cached`` flag (scripted LM behind a real SQLite cache)."""
+    from gift_llm.cache import CachedLM
+    from llm_scripted import ScriptedLM
+
+    rec = tmp_path / "run.jsonl"
+    lm = RecordingLM(CachedLM(ScriptedLM(["ok"]), path=tmp_path / "cache.sqlite"), rec)
+    msgs = [{"role": "user", "content": "Is ice cold?"}]
+    for _ in range(2):
+        lm.complete(msgs, max_tokens=4)
+        lm.choice_probabilities(msgs, ["yes", "no"])
+    lines = [json.loads(x) for x in rec.read_text().splitlines()]
+    assert [x["cached"] for x in lines] == [False, False, True, True]
+    assert [x["request"]["kind"] for x in lines] == ["complete", "choices"] * 2
+    assert all(x["seconds"] >= 0 for x in lines)
+    assert ReplayLM(rec).complete(msgs, max_tokens=4).text == "ok"  # the extra fields do not disturb a replay
+    bare = tmp_path / "bare.jsonl"  # no cache in between: unknown, not a miss
+    RecordingLM(ScriptedLM(["ok"]), bare).complete(msgs)
+    assert json.loads(bare.read_text())["cached"] is None

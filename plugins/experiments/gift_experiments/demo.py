@@ -32,5 +32,5 @@ def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("
     for k in [k for k in KERNEL_ORDER if k in rq1] + [k for k in rq1 if k not in KERNEL_ORDER and k != ORACLE] + [ORACLE]:
         f1 = rq2.get(k, {}).get("train-calibrated", {}).get("all", {}).get("f1")
         print(f"{k:<16} {rq1[k]['mean']:>9.3f} {'' if f1 is None else f'{f1:.3f}':>6}")
-    print(f"({elapsed:.0f} s; report and figures in {out})")
+    print(f"({elapsed:.0f} s; report.html, report.md, figures and replays in {out})")
     return 0

@@ -1,5 +1,5 @@
 """Entry point of gift-experiments: the study commands ``gift reproduce``, ``gift demo`` and
-``gift evaluate-alignment``, thin callers of :mod:`gift.study`."""
+``gift evaluate-alignment``, thin callers of :mod:`gift.study`; ``gift view`` and ``gift report`` show a run."""
 
 from __future__ import annotations
 
@@ -91,17 +91,25 @@ def _config_from_args(args: argparse.Namespace):
 
 
 def run_study_command(cfg, out: Path, command: str, executor=None) -> dict:
-    """Run a study into ``out`` (resuming from its stage caches), write results.json, report.md, figures."""
+    """Run a study into ``out`` (resuming from its stage caches), write results.json, report.md, figures,
+    the Meshcat replays of the first intents (``views/``) and report.html; the LM calls of the run are
+    recorded in ``out/lm_calls.jsonl`` (:mod:`gift_experiments.lm_calls`)."""
     from gift.study.progress import Progress
     from gift.study.sweeps import previous_runs, run_study
+    from gift_experiments.html_report import write_html_report
+    from gift_experiments.lm_calls import recording
     from gift_experiments.report import write_report
+    from gift_experiments.views import export_views
 
     t0 = time.perf_counter()
     echo = executor is not None and not executor.in_process and executor.live_stderr
-    results = run_study(cfg, out, Progress(), log_line=log.info, executor=executor, echo=echo,
-                        previous=previous_runs(out / "results.json"))
+    with recording(out, cfg.lm):
+        results = run_study(cfg, out, Progress(), log_line=log.info, executor=executor, echo=echo,
+                            previous=previous_runs(out / "results.json"))
     results["timing"]["total"] = time.perf_counter() - t0
     write_report(results, out, command=command)
+    export_views(results, out)  # views/<intent>_{demos,test}.html: Meshcat replays of the first two intents
+    write_html_report(results, out, command=command)
     return results
 
 
@@ -111,7 +119,7 @@ def run_reproduce(args: argparse.Namespace) -> int:
     argv = sys.argv[sys.argv.index("reproduce"):] if "reproduce" in sys.argv else ["reproduce"]
     with executor_from_args(args) as executor:  # local workers print their intents' log lines themselves
         run_study_command(cfg, out, "gift " + " ".join(shlex.quote(a) for a in argv), executor)
-    print(f"report: {out / 'report.md'}")
+    print(f"report: {out / 'report.md'} (and {out / 'report.html'})")
     return 0
 
 
@@ -130,6 +138,52 @@ def run_demo(args: argparse.Namespace) -> int:
     _check_choices(argparse.Namespace(reward="maxent-linear", robot=args.robot))
     return demo(intent=args.intent, lm=args.lm, out=Path(args.out), robot=args.robot,
                 kernels=check_kernels(_split(args.kernels)))
+
+
+def _configure_view(p: argparse.ArgumentParser) -> None:
+    from gift_experiments.views import VIEWS
+
+    p.add_argument("out", nargs="?", default="out/demo", help="output folder of gift demo / gift reproduce")
+    p.add_argument("--intent", default=None, help="intent id (default: the run's first)")
+    p.add_argument("--show", default="test", choices=VIEWS,
+                   help="demos: a training scene's demonstration pairs; test: a test scene coloured by alignment "
+                        "with the best- and worst-scored trajectories under the aligned reward")
+    p.add_argument("--kernel", default=None, help="kernel whose alignment to show (default: gift-prob if it ran)")
+    p.add_argument("--pairs", type=int, default=2, help="demonstration pairs to replay (--show demos)")
+    p.add_argument("--export", default=None, metavar="FILE.html",
+                   help="write a self-contained HTML page (no server, no network) instead of serving live")
+    p.add_argument("--port", type=int, default=None, help="live mode: Meshcat port (default: the first free from 7000)")
+    p.add_argument("--seconds", type=float, default=None, help="live mode: stop after this long (default: Ctrl-C)")
+
+
+def run_view(args: argparse.Namespace) -> int:
+    from gift_experiments.views import view_command
+
+    return view_command(Path(args.out), intent=args.intent, show=args.show, kernel=args.kernel, pairs=args.pairs,
+                        export=Path(args.export) if args.export else None, port=args.port, seconds=args.seconds)
+
+
+def _configure_report(p: argparse.ArgumentParser) -> None:
+    p.add_argument("out", nargs="?", default="out/demo", help="output folder of gift demo / gift reproduce")
+    p.add_argument("--no-render", action="store_true",
+                   help="use only the object thumbnails already in OUT/renders (no Drake)")
+    p.add_argument("--views", action="store_true", help="also (re)write the Meshcat replays in OUT/views")
+
+
+def run_report(args: argparse.Namespace) -> int:
+    from gift_experiments.html_report import regenerate
+
+    out = Path(args.out)
+    if args.views:
+        from gift_experiments.views import export_views
+
+        path = out / "results.json"
+        if not path.is_file():
+            raise GiftError(f"no results.json in {out}: give the output folder of gift demo or gift reproduce")
+        for e in export_views(json.loads(path.read_text()), out):
+            print(f"{e['intent']}/{e['view']}: {e.get('file') or e.get('error')}")
+    print(f"report.html: {regenerate(out, render=not args.no_render)}")
+    return 0
 
 
 def _configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
@@ -189,6 +243,10 @@ def gift_register_commands(register):
              configure=_configure_reproduce)
     register("demo", run_demo, help="one intent, small sizes, embedded LM: a table of win rate and F1 per kernel",
              configure=_configure_demo)
+    register("view", run_view, help="replay a run's demonstrations or test trajectories in Drake's Meshcat "
+             "(live, or --export FILE.html)", configure=_configure_view)
+    register("report", run_report, help="write report.html of a gift demo / gift reproduce output folder again",
+             configure=_configure_report)
     register("evaluate-alignment", run_evaluate_alignment,
              help="precision/recall/F1/AUC/FP/FN of kernels on a suite, per intent and per subset",
              configure=_configure_evaluate_alignment)

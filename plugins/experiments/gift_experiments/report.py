@@ -18,6 +18,7 @@ Results layout of a study (every number of a run; figures read only this; NaN is
 
 ``results.json`` is strict JSON (:func:`gift.core.serialization.write_json`): a number that is not defined
 (the AUC of a subset whose objects are all relevant or all irrelevant) is ``null``, and the means below skip it.
+``report.html`` (:mod:`gift_experiments.html_report`) reads the same dictionary and the output folder.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from __future__ import annotations
 import json
 import logging
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -131,6 +132,63 @@ def plot_confounds(results: dict, out: Path, threshold: str) -> Path | None:
     return _save(fig, out / f"confounds_{threshold}.png")
 
 
+def place_labels(ax, xs: Sequence[float], ys: Sequence[float], labels: Sequence[str], fontsize: float = 6.5,
+                 avoid: Sequence[tuple[float, float]] = ()) -> list:
+    """Annotate each point ``(xs[i], ys[i])`` with ``labels[i]`` where the label overlaps no other label and no
+    point (greedy, in order of crowdedness; candidates on rings of growing radius around the point, joined
+    to it by a thin leader line when away from it). Returns the text artists."""
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    to_disp = ax.transData.transform
+    pts = to_disp(np.column_stack([xs, ys])) if len(xs) else np.zeros((0, 2))
+    obstacles = [to_disp(np.asarray(avoid, dtype=float))] if len(avoid) else []
+    blocked = np.concatenate([pts] + obstacles) if obstacles else pts
+    frame = ax.get_window_extent(renderer)
+    r_pt = 4.0 * fig.dpi / 72.0  # marker radius (display px)
+    placed: list[tuple[float, float, float, float]] = []
+    artists = [None] * len(labels)
+    crowd = [int(np.sum(np.hypot(*(pts - p).T) < 40 * fig.dpi / 72)) for p in pts]
+    px = fig.dpi / 72.0
+    for i in sorted(range(len(labels)), key=lambda i: -crowd[i]):
+        probe = ax.text(0, 0, labels[i], fontsize=fontsize)
+        bb = probe.get_window_extent(renderer)
+        probe.remove()
+        w, h = bb.width, bb.height
+        best = None
+        for radius in (5, 10, 16, 24, 34, 46, 60, 76):
+            for ang in np.deg2rad([30, -30, 150, -150, 90, -90, 0, 180, 60, -60, 120, -120]):
+                dx, dy = np.cos(ang) * radius * px, np.sin(ang) * radius * px
+                cx, cy = pts[i, 0] + dx, pts[i, 1] + dy
+                x0 = cx if np.cos(ang) >= -1e-9 else cx - w
+                x0 = cx - w / 2 if abs(np.cos(ang)) < 1e-6 else x0
+                y0 = cy if np.sin(ang) >= 0 else cy - h
+                box = (x0 - 1, y0 - 1, x0 + w + 1, y0 + h + 1)
+                if box[0] < frame.x0 or box[2] > frame.x1 or box[1] < frame.y0 or box[3] > frame.y1:
+                    continue
+                if any(not (box[2] < b[0] or box[0] > b[2] or box[3] < b[1] or box[1] > b[3]) for b in placed):
+                    continue
+                near = (blocked[:, 0] > box[0] - r_pt) & (blocked[:, 0] < box[2] + r_pt) & \
+                       (blocked[:, 1] > box[1] - r_pt) & (blocked[:, 1] < box[3] + r_pt)
+                if near.any():
+                    continue
+                best = (box, radius)
+                break
+            if best:
+                break
+        if best is None:  # nowhere free: the first candidate, overlapping (never silently dropped)
+            box, radius = (pts[i, 0] + 5 * px, pts[i, 1] + 5 * px, pts[i, 0] + 5 * px + w, pts[i, 1] + 5 * px + h), 5
+        else:
+            box, radius = best
+        placed.append(box)
+        x, y = ax.transData.inverted().transform((box[0] + 1, box[1] + 1))
+        artists[i] = ax.annotate(labels[i], (xs[i], ys[i]), xytext=(x, y), textcoords="data", fontsize=fontsize,
+                                 ha="left", va="bottom",
+                                 arrowprops=dict(arrowstyle="-", lw=0.5, color="0.35", shrinkA=0, shrinkB=2)
+                                 if radius > 5 else None)
+    return artists
+
+
 def plot_scatter(results: dict, out: Path) -> list[Path]:
     paths = []
     plt = _plt()
@@ -138,17 +196,20 @@ def plot_scatter(results: dict, out: Path) -> list[Path]:
         pts = block.get("points") or []
         if not pts:
             continue
-        fig, ax = plt.subplots(figsize=(4.2, 4.2))
-        for p in pts:
-            ax.scatter(p["language"], p["vision"], c="tab:green" if p["relevant"] else "tab:red", s=18)
-            ax.annotate(p["object"], (p["language"], p["vision"]), fontsize=6, xytext=(2, 2),
-                        textcoords="offset points")
-        ax.scatter([1.0], [1.0], marker="*", s=120, c="black")
-        ax.annotate(f"anchor: {block['anchor']}", (1.0, 1.0), fontsize=7, xytext=(-60, -10), textcoords="offset points")
+        fig, ax = plt.subplots(figsize=(6.4, 5.6))
+        xs = np.array([p["language"] for p in pts] + [1.0])
+        ys = np.array([p["vision"] for p in pts] + [1.0])
+        ax.scatter(xs[:-1], ys[:-1], c=["tab:green" if p["relevant"] else "tab:red" for p in pts], s=16, zorder=3)
+        ax.scatter([1.0], [1.0], marker="*", s=120, c="black", zorder=3)
+        pad_x, pad_y = 0.12 * max(np.ptp(xs), 0.05), 0.12 * max(np.ptp(ys), 0.05)
+        ax.set_xlim(xs.min() - pad_x, xs.max() + pad_x)
+        ax.set_ylim(ys.min() - pad_y, ys.max() + pad_y)
         ax.set_xlabel("language similarity to anchor")
         ax.set_ylabel("vision similarity to anchor")
         ax.set_title(f"{intent}: green = relevant, red = not", fontsize=8)
-        paths.append(_save(fig, out / f"scatter_{intent}.png"))
+        fig.tight_layout()
+        place_labels(ax, xs, ys, [p["object"] for p in pts] + [f"anchor: {block['anchor']}"])
+        paths.append(_save(fig, out / f"scatter_{intent}.png", tight=False))
     return paths
 
 
@@ -188,8 +249,9 @@ def plot_intent_cosine(results: dict, out: Path) -> Path | None:
     return _save(fig, out / "intent_cosine.png")
 
 
-def _save(fig, path: Path) -> Path:
-    fig.tight_layout()
+def _save(fig, path: Path, tight: bool = True) -> Path:
+    if tight:
+        fig.tight_layout()
     fig.savefig(path, dpi=130)
     import matplotlib.pyplot as plt
 

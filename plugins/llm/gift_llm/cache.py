@@ -367,6 +367,11 @@ class CachedLM(MeteredLM):
         super().__init__(inner)
         self.enabled = bool(enabled) and cache_enabled_by_env()
         self.store = open_store(path, url) if self.enabled else None
+        self._last = threading.local()
+
+    def last_hit(self) -> bool | None:
+        """Whether this thread's last request was answered from the cache (None: none yet, or cache off)."""
+        return getattr(self._last, "hit", None) if self.store is not None else None
 
     def _lookup(self, key: str, kind: str, identity: str, request: Mapping[str, Any], call: Callable[[], Any],
                 encode: Callable[[Any], Any]) -> tuple[Any, Any]:
@@ -377,10 +382,12 @@ class CachedLM(MeteredLM):
                 hit = self.store.get(key)  # another worker may have answered while this one waited
                 if hit is None:
                     self.stats.add_request(hit=False)
+                    self._last.hit = False
                     out = call()
                     self.store.put(key, kind, identity, request, encode(out))
                     return None, out
         self.stats.add_request(hit=True)
+        self._last.hit = True
         return hit, None
 
     def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,

@@ -1,10 +1,12 @@
 """Record every LM call of a run as JSONL, and replay it later with no model at all.
 
-A recording line is ``{"key", "identity", "request", "response"}`` where ``request`` is the canonical
-request of :mod:`gift_llm.requests` (messages and sampling parameters, never credentials) and ``response``
-is the completion (text, usage, model) or the choice probabilities. :class:`ReplayLM` answers each
-request with the recorded responses in the recorded order (the last one repeats if a request comes more
-often than recorded); a request that is not in the recording is an :class:`LMError`.
+A recording line is ``{"key", "identity", "request", "response", "cached", "seconds"}`` where ``request``
+is the canonical request of :mod:`gift_llm.requests` (messages and sampling parameters, never credentials),
+``response`` is the completion (text, usage, model) or the choice probabilities, ``cached`` whether the
+cache answered it (None when no cache was in between) and ``seconds`` the wall-clock time of the call.
+:class:`ReplayLM` answers each request with the recorded responses in the recorded order (the last one
+repeats if a request comes more often than recorded); a request that is not in the recording is an
+:class:`LMError`.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, ClassVar
@@ -35,25 +38,41 @@ class RecordingLM(LMWrapper):
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock = threading.Lock()
 
-    def _write(self, request: Mapping[str, Any], response: Any) -> None:
+    def _hit(self) -> bool | None:
+        last_hit = getattr(self.inner, "last_hit", None)
+        return last_hit() if callable(last_hit) else None
+
+    def _write(self, request: Mapping[str, Any], response: Any, cached: bool | None, seconds: float) -> None:
         line = json.dumps({"key": request_key(None, request), "identity": self.identity(), "request": request,
-                           "response": response}, ensure_ascii=False)
-        with self._lock, open(self.path, "a", encoding="utf-8") as f:
-            f.write(line + "\n")
-            f.flush()
-            os.fsync(f.fileno())
+                           "response": response, "cached": cached, "seconds": round(seconds, 4)},
+                          ensure_ascii=False)
+        data = (line + "\n").encode("utf-8")
+        # one write(2) per line on an O_APPEND descriptor: worker processes recording into the same file
+        # (GIFT_LM_RECORD is inherited) cannot interleave their lines, whatever their length
+        with self._lock:
+            fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+            try:
+                view = memoryview(data)
+                while view:
+                    view = view[os.write(fd, view):]
+                os.fsync(fd)
+            finally:
+                os.close(fd)
 
     def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
                  max_tokens: int = 512, stop: Sequence[str] | None = None,
                  json_schema: Mapping[str, Any] | None = None) -> Completion:
         kw = dict(temperature=temperature, seed=seed, max_tokens=max_tokens, stop=stop, json_schema=json_schema)
+        t0 = time.perf_counter()
         out = self.inner.complete(messages, **kw)
-        self._write(complete_request(messages, **kw), completion_to_json(out))
+        cached = True if out.usage.cached else self._hit()
+        self._write(complete_request(messages, **kw), completion_to_json(out), cached, time.perf_counter() - t0)
         return out
 
     def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
+        t0 = time.perf_counter()
         out = self.inner.choice_probabilities(messages, choices)
-        self._write(choices_request(messages, choices), out)
+        self._write(choices_request(messages, choices), out, self._hit(), time.perf_counter() - t0)
         return out
 
 

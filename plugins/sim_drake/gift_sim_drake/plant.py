@@ -128,11 +128,13 @@ class SceneModel:
     """A Drake diagram of one scene: table, arm (welded), landmarks and the scene's objects as free bodies.
 
     ``bodies[name]`` gives each object's body (and ``"mug"`` for the carried mug). Use :meth:`set_state`
-    to pose the arm and the objects, then query ``plant``/``plant_context``.
+    to pose the arm and the objects, then query ``plant``/``plant_context``. With ``meshcat`` (a
+    ``pydrake.geometry.Meshcat``) the diagram also holds a ``MeshcatVisualizer`` (``visualizer``) that draws
+    the scene on every publish (see :mod:`gift_sim_drake.viewer`).
     """
 
     def __init__(self, spec: RobotSpec, task: str, objects: Sequence[ObjectSpec],
-                 landmarks: Mapping[str, Sequence[float]]) -> None:
+                 landmarks: Mapping[str, Sequence[float]], meshcat=None) -> None:
         builder = DiagramBuilder()
         self.plant, self.scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
         self.robot = add_robot(self.plant, spec)
@@ -148,6 +150,11 @@ class SceneModel:
         if task == "place_mug":
             self.bodies["mug"] = add_free_object(self.plant, "mug", MUG)
         self.plant.Finalize()
+        self.visualizer = None
+        if meshcat is not None:
+            from pydrake.geometry import MeshcatVisualizer
+
+            self.visualizer = MeshcatVisualizer.AddToBuilder(builder, self.scene_graph, meshcat)
         self.diagram = builder.Build()
         self.context = self.diagram.CreateDefaultContext()
         self.plant_context = self.plant.GetMyMutableContextFromRoot(self.context)

@@ -52,6 +52,7 @@ class DrakeSimulator(Simulator):
       (:mod:`gift_sim_drake.motion`); every trajectory acts on one thing, named in ``meta["acted_on"]``.
     - ``features(trajectories, task)``: the family's feature columns ``[N, 61, F]``.
     - ``render_object(obj, size)``: ``[3, size, size, 3]`` uint8 views, cached on disk.
+    - ``replay(scene, clips, ...)``: trajectories of the scene in Drake's Meshcat (:mod:`gift_sim_drake.viewer`).
     """
 
     robot_name: ClassVar[str] = "franka"
@@ -91,6 +92,13 @@ class DrakeSimulator(Simulator):
 
         check_scene(scene)
         return SceneModel(self.robot, scene.task, scene.objects, scene.landmarks)
+
+    def replay(self, scene: Scene, clips, **options):
+        """Record trajectories of ``scene`` in Drake's Meshcat (:func:`gift_sim_drake.viewer.replay`): a
+        :class:`~gift_sim_drake.viewer.Replay` with a live localhost URL and ``static_html()``."""
+        from gift_sim_drake.viewer import replay
+
+        return replay(self.robot, scene, clips, **options)
 
     def render_object(self, obj: ObjectSpec, size: int = 224) -> np.ndarray:
         from gift_sim_drake.render import render_object
