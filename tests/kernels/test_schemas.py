@@ -334,7 +334,29 @@ def test_the_four_calls_of_the_embedded_model_answer_within_their_schemas_with_n
     assert len(lm.seen) == 1 + 1 + 2 + 1  # Call 1, Call 2, two Call-3 samples, the category: no repair
     for schema, text in lm.seen:
         jsonschema.validate(json.loads(text), schema)  # the answer is exactly JSON of its schema
+        assert list(json.loads(text)) == schema["required"]  # with the keys in the schema's order
     assert est.stats.repairs == k.stats.repairs == 0 and not k.fallbacks
     assert 1 <= len(intent.motivations) <= 3 and intent.axes
     assert votes.counts.sum(axis=1).tolist() == [2, 2, 2]
     assert "art" in cat.lower(), cat
+
+
+@pytest.mark.slow
+@pytest.mark.lm
+def test_call3_samples_under_the_grammar_follow_their_seed_and_temperature(embedded_lm):
+    """N samples stay N different draws: the grammar constrains, the seed and temperature still choose."""
+    from gift_llm.backends.llamacpp import LlamaCppLM
+    from gift_kernels.lm_kernels import MappingKernel
+
+    # uncached, and the whole prompt evaluated every time: reusing the KV cache of another prompt changes
+    # the logits in the last bits, which can flip a draw at temperature 0.7
+    raw = embedded_lm.inner
+    lm = Capture(LlamaCppLM(raw.path, n_ctx=raw.n_ctx, reuse_prefix=False))
+    test, train = ["crayons", "apple", "toothbrush", "glue stick", "stapler"], ["paintbrush", "sketchbook", "banana"]
+    MappingKernel(lm=lm, samples=3, temperature=0.7, seed=0).votes(test, train, Intent("pack art supplies"))
+    MappingKernel(lm=lm, samples=1, temperature=0.7, seed=0).votes(test, train, Intent("pack art supplies"))
+    texts = [t for _, t in lm.seen]
+    assert texts[3] == texts[0]  # the same sample (seed, order) again: the same answer
+    for schema, text in lm.seen:
+        assert list(json.loads(text)) == schema["required"]  # the keys in the order the prompt lists them
+    assert len({json.dumps(json.loads(t), sort_keys=True) for t in texts[:3]}) >= 2, texts  # samples differ

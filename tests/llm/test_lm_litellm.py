@@ -64,3 +64,58 @@ def test_dead_server_is_a_clear_error_without_secrets(monkeypatch):
         lm.complete("hello", max_tokens=2)
     msg = str(e.value)
     assert url in msg and "after 2 attempts" in msg and SECRET not in msg
+
+
+# ----------------------------------------------------------------------------- structured output
+
+
+def _call3(lm):
+    """One schema-constrained Call 3 (the ``gift`` kernel, one sample) through ``lm``; its stats and votes."""
+    from gift.core.data import Intent
+    from gift_kernels.lm_kernels import MappingKernel
+
+    k = MappingKernel(lm=lm, samples=1, temperature=0.0)
+    votes = k.votes(["crayons", "apple"], ["paintbrush", "banana"], Intent("pack art supplies"))
+    return k, votes
+
+
+def _as_llama_cpp_server_format(body):
+    """OpenAI structured output -> the ``json_object`` + ``schema`` form, the only one llama_cpp.server reads."""
+    fmt = body.get("response_format") or {}
+    if fmt.get("type") == "json_schema":
+        body = {**body, "response_format": {"type": "json_object", "schema": fmt["json_schema"]["schema"]}}
+    return body
+
+
+@pytest.mark.parametrize("style", [None, "json_schema", "none"])
+def test_call3_schema_goes_over_http_as_each_style_and_the_answer_validates(llama_server, monkeypatch, style):
+    import json
+
+    import jsonschema
+    from gift_kernels import schemas
+    from recording_proxy import recording_proxy
+
+    monkeypatch.setenv("OPENAI_API_KEY", SECRET)
+    with recording_proxy(llama_server, rewrite=_as_llama_cpp_server_format) as (url, exchanges):
+        lm = LiteLLM("openai/local", api_base=url, json_style=style, max_retries=1)
+        k, votes = _call3(lm)
+    body = exchanges[0]["request"]
+    prompt = body["messages"][1]["content"]
+    order = [json.loads(next(ln for ln in prompt.splitlines() if ln.startswith(key)).split(":", 1)[1])
+             for key in ("New objects", "Training objects")]
+    schema = schemas.mapping_schema(*order)
+    assert votes.counts.sum() == 2  # both objects placed
+    if style == "none":  # nothing but the prompt (and gift's validator)
+        assert "response_format" not in body
+        return
+    if style is None:  # an OpenAI-compatible server at api_base: llama.cpp's form, the full schema
+        assert lm.structured_output_style() == "json_object_schema"
+        assert body["response_format"] == {"type": "json_object", "schema": schema}
+    else:  # what providers with structured outputs get: strict, the portable subset
+        fmt = body["response_format"]
+        assert fmt["type"] == "json_schema" and fmt["json_schema"]["strict"] is True
+        assert fmt["json_schema"]["schema"] == schema  # Call 3's schema has no length bounds to drop
+        assert fmt["json_schema"]["schema"]["properties"]["crayons"]["enum"] == [*order[1], "distractor"]
+    assert len(exchanges) == 1 and k.stats.repairs == 0 and not k.fallbacks  # no repair needed
+    answer = json.loads(exchanges[0]["response"]["choices"][0]["message"]["content"])
+    jsonschema.validate(answer, schema)

@@ -2,12 +2,14 @@
 
 ``gift`` / ``lm-no-intent`` (:class:`MappingKernel`): one LM call per sample lists every test object
 (so the calls per intent are ``samples``, independent of the number of trajectories), each sample lists
-the objects in its own shuffled order with its own seed; ``K[i, j]`` = fraction of samples mapping test
+the objects in its own shuffled order with its own seed, and sends the JSON schema of that answer
+(:func:`gift_kernels.schemas.mapping_schema`: every test object a key, each value a training object or
+distractor; on llama.cpp a grammar); ``K[i, j]`` = fraction of samples mapping test
 object i to training object j. The mode over {training objects, distractor} is the binary decision and
 its share the agreement rate (:meth:`MappingKernel.votes`).
 
 ``gift-prob`` (:class:`GiftProbKernel`): a continuous kernel. The LM names, once per intent, the kind of
-object the goal is about ("art supplies"), then answers one yes/no question per object, "is a <object>
+object the goal is about (``{"category": "art supplies"}``, :func:`gift_kernels.schemas.category_schema`), then answers one yes/no question per object, "is a <object>
 (<description>) one of the <category>?", read through ``choice_probabilities``. Its score is the log-odds
 ``log P(yes) - log P(no)``; by default it is averaged, as z-scores, with a contrastive MiniLM description
 similarity (the largest cosine to a training object that is relevant under the intent minus the largest

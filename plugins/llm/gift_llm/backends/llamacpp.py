@@ -1,8 +1,9 @@
 """``llamacpp``: an in-process GGUF through llama-cpp-python.
 
 * Chat through ``create_chat_completion`` with the chat template stored in the GGUF.
-* ``json_schema`` constrains decoding with a :class:`llama_cpp.LlamaGrammar` (built from the schema; a
-  schema without ``properties`` gets the generic JSON-object grammar).
+* ``json_schema`` constrains decoding with a :class:`llama_cpp.LlamaGrammar` (built from the schema, which
+  fixes the order of an object's properties as listed; a schema without ``properties`` gets the generic
+  JSON-object grammar).
 * :meth:`LlamaCppLM.choice_probabilities` evaluates the chat prompt with the assistant turn opened and
   reads the next-token distribution (variants such as ``yes``/``Yes``/`` yes`` are summed).
 * Prompt-prefix reuse: both paths keep the evaluated tokens in the KV cache, and the next call only
@@ -237,7 +238,7 @@ class LlamaCppLM(LMBackend):
         from llama_cpp import LlamaGrammar
         from llama_cpp.llama_grammar import JSON_GBNF
 
-        key = json.dumps(schema, sort_keys=True)
+        key = json.dumps(schema)  # not sort_keys: the grammar writes an object's properties in the schema's order
         if key not in self._grammars:
             try:
                 if schema.get("properties") or schema.get("items") or schema.get("enum"):
