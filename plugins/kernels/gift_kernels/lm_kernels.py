@@ -436,7 +436,9 @@ class GiftProbKernel(RelevanceKernel):
         training objects ``[n_train]`` (a training object is never compared with itself, and its question
         uses a category named without it), on one scale, so the training scores can calibrate a cut.
 
-        ``details``: the category the test objects were asked about and the weight of each term.
+        ``details``: the category the test objects were asked about, the weight of each term and each
+        term alone (``terms``: ``{name: {"relevance": [n_test], "train_loo": [n_train]}}``, sigmoids of its
+        z-scores).
         """
         test, train = list(test), list(train)
         if intent is None:
@@ -468,4 +470,7 @@ class GiftProbKernel(RelevanceKernel):
         weights = {t: v / total for t, v in w.items()}
         z = sum(weights[t] * terms[t] for t in terms)
         details["weights"] = weights
+        # each term alone, on the relevance scale (for the disagreement query policy, gift.core.queries)
+        details["terms"] = {t: {"relevance": _sigmoid(v[: len(test)]).tolist(),
+                                "train_loo": _sigmoid(v[len(test):]).tolist()} for t, v in terms.items()}
         return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details)
