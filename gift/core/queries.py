@@ -52,13 +52,15 @@ How answers update the scene (the rule)
 Intent candidates and terms a kernel reports
 --------------------------------------------
 A relevance kernel may report other views of the same scene in ``RelevanceScores.details``, each as
-``{"relevance": [n_test], "train_loo": [n_train]}`` (values in [0, 1]):
+``{"relevance": [n_test], "train_loo": [n_train]}`` (values in [0, 1]) or as raw scores ``{"test":
+[n_test], "train": [n_train]}`` (any monotone scale; put on the relevance scale by a pooled z-score and a
+sigmoid), see :func:`views_from_details`:
 
-- ``details["candidates"]``: ``{name: view}``, other intent candidates; :meth:`QueryProblem.of` adds
-  them after the kernel's own choice;
-- ``details["terms"]``: ``{name: view}``, the terms the kernel combined (``gift-prob``: its LM log-odds
-  and MiniLM terms, as sigmoids of their z-scores), used by the ``disagreement`` policy when there is a
-  single candidate.
+- ``details["candidates"]``: other intent candidates (a mapping, or ``gift-prob``'s list of verified
+  candidate goals, whose test scores it reports with ``candidate_terms=True`` as ``lm_test`` /
+  ``lm_train``, its LM term alone); :meth:`QueryProblem.of` adds them after the kernel's own choice;
+- ``details["terms"]``: the terms the kernel combined (``gift-prob``: its LM log-odds and its MiniLM
+  term), used by the ``disagreement`` policy when there is a single candidate.
 
 Beliefs and error bounds the policies use
 -----------------------------------------
@@ -211,20 +213,59 @@ def _check_band(inst: Any, attribute: attrs.Attribute, value: float) -> None:
                         f"got {value}")
 
 
+def _zsigmoid(values: Sequence[float], n_test: int) -> tuple[np.ndarray, np.ndarray]:
+    """Raw scores of the test and training objects on the relevance scale: a z-score pooled over both,
+    then a sigmoid (as ``gift-prob`` combines its terms)."""
+    v = np.asarray(values, dtype=float)
+    sd = v.std()
+    z = (v - v.mean()) / sd if sd > 1e-9 else v - v.mean()
+    r = 1.0 / (1.0 + np.exp(-z))
+    return r[:n_test], r[n_test:]
+
+
 def views_from_details(scores: AlignmentScores, key: str) -> dict[str, AlignmentScores]:
-    """The views a relevance kernel reported in ``scores.details[key]`` (``"candidates"`` or ``"terms"``),
-    each as the scores of the same scene (:meth:`AlignmentScores.with_relevance`); {} when there are none."""
+    """The views a relevance kernel reported in ``scores.details[key]`` (``"terms"`` or ``"candidates"``),
+    each as the scores of the same scene (:meth:`AlignmentScores.with_relevance`); {} when there are none.
+
+    ``details[key]`` maps names to views, or is a list of views named by their ``name``, ``goal`` or
+    ``category`` (entries marked ``"chosen": true`` are the kernel's own scores and are skipped). A view
+    gives ``relevance`` / ``train_loo`` in [0, 1], used as they are, or raw scores ``test`` / ``train``
+    (``gift-prob``'s candidates: ``lm_test`` / ``lm_train``), put on the relevance scale by
+    :func:`_zsigmoid`. Entries without scores of the test objects (e.g. a candidate only verified on the
+    training objects) are skipped.
+    """
     raw = (scores.details or {}).get(key)
     if not raw:
         return {}
-    if not isinstance(raw, Mapping):
-        raise GiftError(f"kernel {scores.kernel!r}: details[{key!r}] must map names to "
-                        f"{{'relevance': [...], 'train_loo': [...]}}, got {type(raw).__name__}")
-    out = {}
-    for name, view in raw.items():
-        if not isinstance(view, Mapping) or "relevance" not in view or "train_loo" not in view:
-            raise GiftError(f"kernel {scores.kernel!r}: details[{key!r}][{name!r}] needs 'relevance' and 'train_loo'")
-        out[str(name)] = scores.with_relevance(view["relevance"], view["train_loo"])
+    if isinstance(raw, Mapping):
+        entries = [(str(name), view) for name, view in raw.items()]
+    elif isinstance(raw, Sequence) and not isinstance(raw, str):
+        entries = [(str(v.get("name") or v.get("goal") or v.get("category") or f"{key} {k}") if isinstance(v, Mapping)
+                    else f"{key} {k}", v) for k, v in enumerate(raw)]
+    else:
+        raise GiftError(f"kernel {scores.kernel!r}: details[{key!r}] must be a mapping or a list of views, "
+                        f"got {type(raw).__name__}")
+    n, m = len(scores.test), len(scores.train)
+    out: dict[str, AlignmentScores] = {}
+    for name, view in entries:
+        if not isinstance(view, Mapping):
+            raise GiftError(f"kernel {scores.kernel!r}: details[{key!r}] entry {name!r} is not a mapping")
+        if view.get("chosen") is True:
+            continue
+        if "relevance" in view and "train_loo" in view:
+            rel, loo = view["relevance"], view["train_loo"]
+        else:
+            pair = next(((view[a], view[b]) for a, b in (("test", "train"), ("lm_test", "lm_train"))
+                         if a in view and b in view), None)
+            if pair is None:
+                continue
+            if len(pair[0]) != n or len(pair[1]) != m:
+                raise GiftError(f"kernel {scores.kernel!r}: details[{key!r}][{name!r}] has {len(pair[0])} test / "
+                                f"{len(pair[1])} training scores for {n} / {m} objects")
+            rel, loo = _zsigmoid(list(pair[0]) + list(pair[1]), n)
+        while name in out:
+            name += "'"
+        out[name] = scores.with_relevance(rel, loo)
     return out
 
 

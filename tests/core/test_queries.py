@@ -177,6 +177,17 @@ def test_answers_choose_among_intent_candidates():
     s = scores_of(details={"candidates": {"metal items": {"relevance": [0.2, 0.9, 0.1, 0.95],
                                                            "train_loo": [0.8, 0.7, 0.3, 0.2]}}})
     assert list(QueryProblem.of(s).candidates) == ["primary", "metal items"]
+    # gift-prob's list of verified candidate goals: the chosen one is the kernel's own; one without test scores
+    # (verified on the training objects only) is no view
+    listed = [{"goal": "pack art supplies", "chosen": True, "lm_test": [1] * 4, "lm_train": [1] * 4},
+              {"goal": "store metal items", "chosen": False, "lm_test": [-2.0, 3.0, -3.0, 4.0],
+               "lm_train": [2.0, 1.5, -1.0, -2.0]},
+              {"goal": "tidy up", "chosen": False}]
+    p = QueryProblem.of(scores_of(details={"candidates": listed}))
+    assert list(p.candidates) == ["primary", "store metal items"]
+    assert resolve(p, [Answer("w", True)]).chosen == "store metal items"
+    with pytest.raises(GiftError, match="3 test / 4 training scores for 4 / 4"):
+        QueryProblem.of(scores_of(details={"candidates": [{"goal": "g", "test": [1, 2, 3], "train": [1] * 4}]}))
     with pytest.raises(GiftError, match="another scene"):
         QueryProblem.of(primary, candidates={"bad": scores_of(test_r={"x": 0.1, "q": 0.2, "z": 0.3, "w": 0.4})})
 
@@ -202,6 +213,12 @@ def test_disagreement_asks_where_the_kernels_terms_disagree_and_degrades_to_unce
     assert np.argmax(np.ptp(np.stack(list(views.values())), axis=0)) == 2
     pol = gift.get_query_policy("disagreement")
     assert pol.choose(st, np.random.default_rng(0)) == "z"  # the terms disagree on z most
+    # raw terms (gift-prob reports log-odds and cosines) are put on the relevance scale: same order
+    raw = {"lm": {"test": [4.0, 1.0, -3.0, -5.0], "train": [3.0, 2.0, -2.0, -4.0]},
+           "language": {"test": [0.4, 0.1, 0.4, -0.2], "train": [0.3, 0.2, -0.1, -0.2]}}
+    st_raw = resolve(QueryProblem.of(scores_of(details={"terms": raw})))
+    v = st_raw.view_beliefs()
+    assert np.argsort(v["lm"]).tolist() == [3, 2, 1, 0] and pol.choose(st_raw, np.random.default_rng(0)) == "z"
     plain = resolve(QueryProblem.of(scores_of()))  # no terms, one candidate: the nearest the cut
     assert plain.view_beliefs() == {}
     assert pol.choose(plain, np.random.default_rng(0)) == gift.get_query_policy("uncertainty").choose(

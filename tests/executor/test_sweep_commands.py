@@ -93,9 +93,12 @@ def test_evaluate_alignment_json_is_identical_on_serial_local_and_ray(sweep_runs
         assert result["kernels"][k]["overall"]["oracle"]["all"]["n"] == 12
     assert result["kernels"]["language:use_descriptions=maybe"]["errors"]["*"].startswith("GiftError")
     assert result["kernels"]["no-such-kernel"]["errors"]["*"].startswith("UnknownComponentError")
-    want = canonical(ref["alignment"], {"seconds"})
+    want = canonical(ref["alignment"], {"seconds", "manifest"})
     for name, run in sweep_runs.items():
-        assert canonical(run["alignment"], {"seconds"}) == want, f"evaluate-alignment on {name} differs from serial"
+        assert canonical(run["alignment"], {"seconds", "manifest"}) == want, \
+            f"evaluate-alignment on {name} differs from serial"
+        manifest = json.loads(run["alignment"].read_text())["manifest"]
+        assert manifest["executor"]["name"] == name and manifest["suite"]["sha256"] and manifest["code_version"]
     if "local" not in sweep_runs:
         pytest.fail("the local executor did not run")
 
@@ -118,9 +121,9 @@ def test_reproduce_results_json_is_identical_on_serial_local_and_ray(sweep_runs)
         assert set(results["rq1"][intent]) == {"language", "vision", "oracle-labels"}
         assert len(results["scatter"][intent]["points"]) == 6
     assert "errors" not in results and "lm" not in results["manifest"]  # no LM was needed
-    want = canonical(ref["results"], {"timing", "manifest"})
+    want = canonical(ref["results"], {"timing", "manifest", "seconds"})
     for name, run in sweep_runs.items():
-        assert canonical(run["results"], {"timing", "manifest"}) == want, f"reproduce on {name} differs from serial"
+        assert canonical(run["results"], {"timing", "manifest", "seconds"}) == want, f"reproduce on {name} differs from serial"
         manifest = json.loads(run["results"].read_text())["manifest"]
         assert manifest["executor"] == {"name": name, "max_workers": 1 if name == "serial" else 2}
         # executor options are not part of the stage keys: the same stage files on every executor
@@ -232,7 +235,7 @@ def test_evaluate_alignment_inferred_intents_failing_the_same_way_on_serial_and_
         result = evaluate_alignment(str(SUITE), ["language", "vision"], intent_source="inferred",
                                     lm="no-such-backend:x", progress=lines.append, executor=executor)
         assert len(lines) == 4 and all(": FAILED LMError: unknown LM 'no-such-backend:x'" in line for line in lines)
-        got[name] = json.dumps(without(result, {"seconds"}))
+        got[name] = json.dumps(without(result, {"seconds", "manifest"}))
     assert got["serial"] == got["local"]
     kernels = json.loads(got["serial"])["kernels"]
     assert all(set(k["errors"]) == set(INTENTS) and not k["intents"] for k in kernels.values())

@@ -19,7 +19,8 @@ from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift.core.suite import load_suite
 from gift_kernels import prompts
-from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_mapping
+from gift_kernels.lm_kernels import (GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_category_answer,
+                                     parse_mapping)
 
 SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
 
@@ -51,6 +52,11 @@ class ScriptedLM(LMBackend):
 
 class PlainLM(ScriptedLM):
     supports_choice_probabilities = False
+
+
+def category_json(category: str) -> str:
+    """A category answer in the JSON of ``schemas.category_schema``."""
+    return json.dumps({"category": category})
 
 
 def _names_in_order(text: str, key: str) -> list[str]:
@@ -144,7 +150,7 @@ def _probs_by_name(table):
 def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
              "toothbrush": 0.4, "apple": 0.05}
-    lm = ScriptedLM(answer=lambda m, s: "Art supplies.", probs=_probs_by_name(table))
+    lm = ScriptedLM(answer=lambda m, s: category_json("Art supplies."), probs=_probs_by_name(table))
     k = GiftProbKernel(lm=lm, combine="none", category_from="goal")
     lo = k.log_odds(TEST, ART)
     assert np.allclose(lo, [np.log(0.7 / 0.3), np.log(0.4 / 0.6), np.log(0.05 / 0.95)])
@@ -167,8 +173,8 @@ def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
 
 def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects_leaving_each_one_out():
     def answer(messages, seed):  # the category the scripted LM names: from the last question's handled objects
-        m = re.search(r"handled as part of this goal: (.*)\.\n", messages[-1].content)
-        return "drawing books" if m and "paintbrush" not in m.group(1) else "art supplies"
+        m = re.search(r"kept clear of them\): (.*)\.\n", messages[-1].content)
+        return category_json("drawing books" if m and "paintbrush" not in m.group(1) else "art supplies")
 
     lm = ScriptedLM(answer=answer, probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2,
                                                           "coffee mug": 0.1, "crayons": 0.7, "toothbrush": 0.4,
@@ -181,9 +187,9 @@ def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects
     # the full question, then one per training object, named without it
     assert len(cats) == 1 + len(TRAIN)
     assert cats[0].startswith("Goal: pick up the sketchbook.\n") and \
-        "handled as part of this goal: paintbrush, sketchbook.\nObjects they left alone: banana, coffee mug." in cats[0]
-    assert "handled as part of this goal: sketchbook.\nObjects they left alone: banana, coffee mug." in cats[1]
-    assert "left alone: coffee mug." in cats[3] and "left alone: banana." in cats[4]
+        "them): paintbrush, sketchbook.\nObjects it did not concern: banana, coffee mug." in cats[0]
+    assert "them): sketchbook.\nObjects it did not concern: banana, coffee mug." in cats[1]
+    assert "did not concern: coffee mug." in cats[3] and "did not concern: banana." in cats[4]
     questions = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
     assert "Is a crayons (sticks of colored wax) one of the art supplies? Answer yes or no." in questions
     assert any(q.startswith("Is a paintbrush (a brush for paint) one of the drawing books?") for q in questions)
@@ -201,7 +207,7 @@ def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects
 def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_questions_each_once():
     from gift.core.alignment import score_alignment
 
-    lm = ScriptedLM(answer=lambda m, s: "art supplies" if "handled" in m[-1].content else "art things",
+    lm = ScriptedLM(answer=lambda m, s: category_json("art supplies" if "concerned" in m[-1].content else "art things"),
                     probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1,
                                           "crayons": 0.7, "toothbrush": 0.4, "apple": 0.05}))
     k = GiftProbKernel(lm=lm, combine="none")
@@ -239,7 +245,8 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
-        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=lambda t: {"yes": .5, "no": .5}),
+        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                     probs=lambda t: {"yes": .5, "no": .5}),
                        combine="none").score(TEST, TRAIN, ART, relevant_train=("ghost",))
 
 
@@ -258,13 +265,17 @@ def test_category_answers_are_parsed_or_fall_back_to_the_goal_with_a_warning():
     assert prompts.parse_category("Answer: the valuables") == "valuables"
     for bad in ("", "   \n ", "these are all the objects that the goal could possibly be about here"):
         assert prompts.parse_category(bad) is None
-    lm = ScriptedLM(answer=lambda m, s: "", probs=lambda t: {"yes": 0.6, "no": 0.4})
+    # an answer that is no short noun phrase is asked again once, then the goal stands in
+    answers = iter(["", category_json("these are all the objects that the goal could possibly be about here")])
+    lm = ScriptedLM(answer=lambda m, s: next(answers), probs=lambda t: {"yes": 0.6, "no": 0.4})
     k = GiftProbKernel(lm=lm, combine="none")
     with pytest.warns(UserWarning, match="no object category.*pack art supplies"):
         k.log_odds(TEST[:1], ART)
     assert 'one of the things the goal "pack art supplies" is about?' in lm.calls[-1][0][1].content
-    k.log_odds(TEST[1:], ART)  # the goal's category is asked once
-    assert sum(c[0][0].content == prompts.CATEGORY_SYSTEM for c in lm.calls) == 1
+    k.log_odds(TEST[1:], ART)  # the goal's category is asked once (the first answer and one repair)
+    asked = [c[0] for c in lm.calls if c[0][0].content == prompts.CATEGORY_SYSTEM]
+    assert len(asked) == 2 and "no Python dictionary" in asked[1][-1].content
+    assert parse_category_answer({"category": "the Art supplies."}) == {"category": "Art supplies"}
 
 
 class TableKernel(SimilarityKernel):
@@ -291,7 +302,8 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
     rel = ("paintbrush", "sketchbook")
 
     def kernel(weighting):
-        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=_probs_by_name(table)),
+        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                            probs=_probs_by_name(table)),
                               weighting=weighting, language_kernel=TableKernel(vec))
 
     k = kernel("reliability")
@@ -391,3 +403,70 @@ def test_gift_and_lm_no_intent_on_the_embedded_model_map_every_object_within_the
     assert K.shape == (2, 4) and np.all(np.isin(K, [0.0, 0.5, 1.0]))
     k0 = gift.get_kernel("lm-no-intent", lm=embedded_lm, samples=1)
     assert k0.similarity(test, TRAIN, ART).shape == (2, 4) and k0.calls == 1
+
+
+def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_chosen_one_asks_the_test_objects():
+    """candidates="all": the intent's text, its other motivations and the objects alone each name a category;
+    the one whose leave-one-out log-odds separate the demonstrated objects best names the test questions."""
+    def answer(messages, seed):
+        q = messages[-1].content
+        if q.startswith("Goal: pick up the sketchbook"):
+            return category_json("sketchbooks")
+        if q.startswith("Goal: tidy the table"):
+            return category_json("table things")
+        return category_json("art supplies")  # from the objects alone
+
+    yes = {("sketchbooks", "sketchbook"): 0.9, ("sketchbooks", "paintbrush"): 0.2,
+           ("table things", "banana"): 0.8, ("table things", "coffee mug"): 0.8,
+           ("art supplies", "paintbrush"): 0.9, ("art supplies", "sketchbook"): 0.8, ("art supplies", "crayons"): 0.85}
+
+    def probs(text):
+        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        p = yes.get((cat, name), 0.1)
+        return {"yes": p, "no": 1.0 - p}
+
+    lm = ScriptedLM(answer=answer, probs=probs)
+    intent = Intent(text="The person wanted to pick up the sketchbook.", source="inferred",
+                    motivations=(gift.Motivation("The person wanted to pick up the sketchbook."),
+                                 gift.Motivation("The person wanted to tidy the table.")))
+    k = GiftProbKernel(lm=lm, combine="none", candidates="all")
+    assert k.candidate_goals(intent, ("paintbrush", "sketchbook")) == [intent.text, "The person wanted to tidy the table.",
+                                                                        None]
+    rs = k.score(TEST, TRAIN, intent, ("paintbrush", "sketchbook"))
+    cands = {c["category"]: c for c in rs.details["candidates"]}
+    assert set(cands) == {"sketchbooks", "table things", "art supplies"}
+    assert cands["art supplies"]["chosen"] and cands["art supplies"]["auc"] == 1.0
+    assert cands["table things"]["auc"] == 0.0  # inverts the demonstrated objects
+    # the goal naming one member separates them too, by a smaller margin: the objects' category wins the tie
+    assert cands["sketchbooks"]["auc"] == 1.0 and cands["sketchbooks"]["margin"] < cands["art supplies"]["margin"]
+    assert rs.details["category"] == "art supplies" and rs.details["goal"] is None
+    assert np.allclose(rs.relevance, [0.85, 0.1, 0.1])
+    asked = [c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM]
+    test_questions = [q for q in asked if any(f"Is a {o.name} (" in q for o in TEST)]
+    assert len(test_questions) == len(TEST) and all("art supplies" in q for q in test_questions)
+    # the objects-only category question carries no goal line
+    objects_only = [c[0][-1].content for c in lm.calls
+                    if c[0][0].content == prompts.CATEGORY_SYSTEM and not c[0][-1].content.startswith("Goal:")]
+    assert objects_only and objects_only[0].endswith("Which kind of objects is the goal about?")
+    with pytest.raises(GiftError, match="candidates"):
+        GiftProbKernel(candidates="some")
+
+
+def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_suite():
+    """The category prompts' worked examples: none of their objects is in a suite catalog, and no word of
+    their goals and categories is a content word of a suite's goal (beyond function words and generic nouns
+    such as "supplies")."""
+    from gift.plugins.manager import get_manager
+
+    suites = [load_suite(s) for s in get_manager().suites()] + [load_suite(SUITE)]
+    objects = {o.lower() for s in suites for o in s.objects}
+    stop = {"the", "things", "thing", "and", "with", "from", "to", "of", "a", "an", "for", "anything", "away",
+            "put", "keep", "pack", "store", "get", "in", "on", "it", "that", "would", "if",
+            "supplies", "items", "objects", "goods"}  # generic nouns of a kind, not a kind themselves
+    goal_words = {w for s in suites for i in s.intents for w in re.findall(r"[a-z]+", i.text.lower())} - stop
+    examples = [(g, h + a, c) for g, h, a, c in prompts.CATEGORY_EXAMPLES_WITH_OBJECTS]
+    examples += [(g, (), c) for g, c in prompts.CATEGORY_EXAMPLES]
+    for goal, objs, category in examples:
+        assert not {o.lower() for o in objs} & objects, objs
+        words = set(re.findall(r"[a-z]+", f"{goal} {category}".lower())) - stop
+        assert not words & goal_words, (goal, words & goal_words)

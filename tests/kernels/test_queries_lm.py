@@ -45,10 +45,14 @@ def test_the_real_kernel_reports_the_terms_the_disagreement_policy_reads(scene):
     terms = scores.details["terms"]
     assert set(terms) == {"lm", "language"}
     for view in terms.values():
-        assert len(view["relevance"]) == len(TEST) and len(view["train_loo"]) == 4
-        assert all(0.0 < v < 1.0 for v in view["relevance"] + view["train_loo"])
+        assert len(view["test"]) == len(TEST) and len(view["train"]) == 4
     st = resolve(QueryProblem.of(scores))
-    assert set(st.view_beliefs()) == {"lm", "language"}
+    views = st.view_beliefs()
+    assert set(views) == {"lm", "language"} and all(v.shape == (len(TEST),) for v in views.values())
+    # the LM's log-odds order the test objects the same way its view does
+    lm = np.asarray(terms["lm"]["test"])
+    assert np.array_equal(np.argsort(lm, kind="stable"), np.argsort(views["lm"], kind="stable")) or \
+        len(set(np.round(lm, 9))) < len(lm)
 
 
 @pytest.mark.parametrize("policy", ["uncertainty", "disagreement", "error-bound", "random"])
@@ -66,8 +70,10 @@ def test_each_policy_asks_about_the_real_scores_and_the_answers_re_score_the_sce
         assert asked[0] == TEST[int(np.argmin(np.round(np.abs(d - cut), 12)))]
     elif policy == "disagreement":
         views = []
-        for view in scores.details["terms"].values():
-            v = scores.with_relevance(view["relevance"], view["train_loo"])
+        for view in scores.details["terms"].values():  # each term on the relevance scale: sigmoid(z-score)
+            raw = np.array(view["test"] + view["train"])
+            r = 1 / (1 + np.exp(-(raw - raw.mean()) / raw.std()))
+            v = scores.with_relevance(r[: len(TEST)], r[len(TEST):])
             views.append(belief(v.decision, answered_cut(v, "train-calibrated", ())[0]))
         spread = np.ptp(np.stack(views), axis=0)
         assert spread[TEST.index(asked[0])] == pytest.approx(spread.max())

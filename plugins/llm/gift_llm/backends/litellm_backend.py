@@ -25,6 +25,53 @@ from gift_llm.backends.common import choice_variants, message_dicts, renormalise
 LOGPROB_PROVIDERS = ("openai", "hosted_vllm", "together_ai", "fireworks_ai", "deepseek")
 
 
+#: How a JSON schema reaches the provider: ``json_schema`` (OpenAI structured outputs:
+#: ``{"type": "json_schema", "json_schema": {"name", "schema", "strict"}}``), ``json_object_schema``
+#: (llama.cpp server: ``{"type": "json_object", "schema": ...}``), ``json_object`` (JSON mode, no schema),
+#: ``none`` (no ``response_format``; the prompt and gift's validators only); ``None``: chosen per model.
+JSON_STYLES = (None, "json_schema", "json_object_schema", "json_object", "none")
+#: Keywords left out of schemas sent as ``json_schema``: providers' strict modes reject length bounds
+#: (gift's validators check what the schema no longer says).
+UNPORTABLE_KEYWORDS = frozenset({"minLength", "maxLength", "minItems", "maxItems"})
+
+
+def _map_subschemas(schema: Mapping[str, Any], f: Any) -> dict[str, Any]:
+    """``schema`` with ``f`` applied to each direct subschema (properties, items, combinators)."""
+    out: dict[str, Any] = {}
+    for k, v in schema.items():
+        if k == "properties" and isinstance(v, Mapping):
+            out[k] = {name: f(sub) for name, sub in v.items()}
+        elif k in ("items", "additionalProperties", "not") and isinstance(v, Mapping):
+            out[k] = f(v)
+        elif k in ("anyOf", "oneOf", "allOf", "prefixItems") and isinstance(v, list):
+            out[k] = [f(sub) for sub in v]
+        else:
+            out[k] = v
+    return out
+
+
+def portable_schema(schema: Mapping[str, Any]) -> dict[str, Any]:
+    """A copy of ``schema`` without :data:`UNPORTABLE_KEYWORDS` in any (sub)schema."""
+    return _map_subschemas({k: v for k, v in schema.items() if k not in UNPORTABLE_KEYWORDS}, portable_schema)
+
+
+def strict_compatible(schema: Mapping[str, Any]) -> bool:
+    """Whether every object in ``schema`` requires all its properties and forbids others, as OpenAI's
+    strict structured outputs demand."""
+    if schema.get("type") == "object" or "properties" in schema:
+        props = schema.get("properties") or {}
+        if schema.get("additionalProperties") is not False or set(schema.get("required") or ()) != set(props):
+            return False
+    ok = [True]
+
+    def visit(sub: Mapping[str, Any]) -> Mapping[str, Any]:
+        ok[0] = ok[0] and strict_compatible(sub)
+        return sub
+
+    _map_subschemas(schema, visit)
+    return ok[0]
+
+
 def _litellm() -> Any:
     os.environ.setdefault("LITELLM_LOCAL_MODEL_COST_MAP", "True")
     try:
@@ -58,21 +105,45 @@ class LiteLLM(LMBackend):
         self.supports_choice_probabilities = (provider in LOGPROB_PROVIDERS if logprobs is None  # type: ignore[misc]
                                               else bool(logprobs))
         self.top_logprobs = int(top_logprobs)
-        if json_style not in (None, "json_schema", "json_object_schema"):
-            raise LMError(f"litellm {self.model}: json_style must be 'json_schema' or 'json_object_schema', "
+        if json_style not in JSON_STYLES:
+            raise LMError(f"litellm {self.model}: json_style must be one of {[s for s in JSON_STYLES if s]}, "
                           f"got {json_style!r}")
         self.json_style = json_style
 
-    def _response_format(self, schema: Mapping[str, Any]) -> dict[str, Any]:
-        """OpenAI style (``json_schema``) for providers; llama.cpp-server style (``json_object`` + ``schema``)
-        for OpenAI-compatible servers at ``api_base``."""
-        style = self.json_style or ("json_object_schema" if self.api_base and self.model.startswith("openai/")
-                                    else "json_schema")
+    def structured_output_style(self) -> str:
+        """How a ``json_schema`` is sent (see :data:`JSON_STYLES`): ``json_style`` when given; else
+        ``json_object_schema`` for an OpenAI-compatible server at ``api_base`` (llama.cpp's server turns the
+        schema into a grammar; other servers fall back to JSON mode); ``json_schema`` when litellm's
+        ``supports_response_schema`` says the provider enforces schemas; ``json_object`` (JSON mode) when
+        the provider takes a ``response_format`` at all; else ``none``."""
+        if self.json_style:
+            return self.json_style
+        if self.api_base and self.model.startswith("openai/"):
+            return "json_object_schema"
+        litellm = _litellm()
+        try:
+            if litellm.supports_response_schema(model=self.model):
+                return "json_schema"
+        except Exception:  # noqa: BLE001 - a model litellm does not know: no schema support claimed
+            pass
+        try:
+            params = litellm.get_supported_openai_params(model=self.model) or []
+        except Exception:  # noqa: BLE001
+            params = []
+        return "json_object" if "response_format" in params else "none"
+
+    def _response_format(self, schema: Mapping[str, Any]) -> dict[str, Any] | None:
+        """The ``response_format`` of a request with ``schema`` (``None``: send none)."""
+        style = self.structured_output_style()
+        if style == "none":
+            return None
         if style == "json_object_schema":
             return {"type": "json_object", "schema": dict(schema)}
-        if not schema.get("properties"):
+        if style == "json_object" or not schema.get("properties"):
             return {"type": "json_object"}
-        return {"type": "json_schema", "json_schema": {"name": "answer", "schema": dict(schema)}}
+        portable = portable_schema(schema)
+        return {"type": "json_schema", "json_schema": {"name": "answer", "schema": portable,
+                                                       "strict": strict_compatible(portable)}}
 
     def identity(self) -> str:
         return f"{self.name}:{self.model}" + (f"@{self.api_base}" if self.api_base else "")
@@ -128,8 +199,8 @@ class LiteLLM(LMBackend):
             kw["seed"] = int(seed)
         if stop:
             kw["stop"] = list(stop)
-        if json_schema is not None:
-            kw["response_format"] = self._response_format(json_schema)
+        if json_schema is not None and (fmt := self._response_format(json_schema)) is not None:
+            kw["response_format"] = fmt
         t0 = time.perf_counter()
         resp = self._call(**kw)
         latency = time.perf_counter() - t0
