@@ -339,6 +339,8 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
             intent, relevant = item.front.intent, item.front.relevant
         try:
             scores, cuts, metrics = score_intent(kernel, suite, spec, intent, relevant.names, cfg.thresholds)
+            # the simulated human answers (no trajectories here: the error bound counts one state per object)
+            queried = query_stage(cfg, spec, scores) if cfg.queries or cfg.abstain else None
         except Exception as e:  # noqa: BLE001 - one failing intent must not lose the others
             failure = Failure.current(e)
             out = ItemOutcome(item.kernel, item.intent_id, error=failure.text, seconds=time.perf_counter() - t0,
@@ -347,8 +349,8 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
             seconds = time.perf_counter() - t0
             record = alignment_record(scores, cuts, metrics, seconds)
             record.update({"intent": spec.id, "intent_text": intent.text, "relevant": relevant.to_dict()})
-            if cfg.queries or cfg.abstain:  # the simulated human answers; no trajectories here
-                record["queries"] = query_stage(cfg, spec, scores)
+            if queried is not None:
+                record["queries"] = queried
             out = ItemOutcome(item.kernel, item.intent_id, record=record, seconds=seconds,
                               line=_done_line(item.kernel, spec.id, record, seconds))
     out = attrs.evolve(out, lm=_lm_delta(comp, before))

@@ -79,7 +79,7 @@ def test_evaluate_alignment_with_queries_answered_from_the_suite_labels(tmp_path
     out = tmp_path / "res.json"
     code = main(["evaluate-alignment", "--suite", SUITE, "--kernels", "language", "--threshold",
                  "train-calibrated,oracle", "--queries", "2", "--policy", "uncertainty", "--abstain", "0.01",
-                 "--out", str(out), "-q"])
+                 "--out", str(out), "--executor", "serial", "-q"])
     assert code == 0
     table = capsys.readouterr().out
     assert "| language | train-calibrated +2q uncertainty abstain 0.01 (" in table
