@@ -78,6 +78,8 @@ def run(args: argparse.Namespace) -> dict:
             if not data:
                 continue
             sim = qc.simulate(data, random_seeds=args.random_seeds)
+            # the first cut rule tried (widest gap), for the record
+            sim["widest"] = qc.simulate(data, random_seeds=args.random_seeds, bands=(), move="widest")["curves"]
             sim.update({"suite": suite.name, "intent_source": source, "robot": args.robot, "kernel": args.kernel,
                         "config": attrs.asdict(cfg), "target": qc.target_check(sim),
                         "intents": {d.intent: {"intent_text": d.intent_text, "relevant": list(d.relevant),
@@ -156,6 +158,11 @@ def write(result: dict, md: Path) -> None:
                 lines.append(f"| {row['k']} | {_fmt(row['f1'])} | "
                              f"{'more than ' + str(grid[-1]) if row['random_needs'] is None else _fmt(row['random_needs'], 1)} | "
                              f"{'–' if row['ratio'] is None else _fmt(row['ratio'], 2)} |")
+            lines += ["", "The first cut rule tried, the widest-gap midpoint of the evidence (`move=\"widest\"`, "
+                      "dropped, see `gift.core.queries`), pooled F1 after k questions:", "",
+                      "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
+            for policy in qc.POLICIES + (qc.BASELINE,):
+                lines.append(f"| {policy} | " + " | ".join(_fmt(v) for v in r["widest"][policy]["f1"]) + " |")
             lines += ["", "Abstention at k = 0 (objects within the band of the cut are flagged and dropped like "
                       "distractors; F1 counts them as not aligned, *F1 decided* leaves them out):", "",
                       "| band | flagged objects | F1 (pooled) | F1 decided (mean over intents) | win rate |",

@@ -27,17 +27,23 @@ How answers update the scene (the rule)
    match: the human vouched for it, so it adds nothing to the error bound. "No" makes it a distractor.
    Naming a training object the goal does not make relevant aligns the object to it, as not relevant.
    "Don't know" (``None``) fixes nothing, adds no evidence, and the object is not asked again.
-2. **Answers join the evidence of the train-calibrated cut.** The ``train-calibrated`` cut separates
-   the training objects' leave-one-out scores (relevant ones positive, the others negative); each
-   answered test object adds its own decision score to that evidence, as a positive ("yes", or naming a
-   relevant training object) or a negative ("no", or naming another one), and the cut is again the
-   best separating midpoint (:func:`~gift.core.alignment.best_separating_cut`). Decision scores are on
-   one scale for test and training objects, so this is the same cut with more labelled points. When the
-   training side gives no positive or no negative (no relevant training object is known), the answers
-   alone place the cut as soon as they hold both a "yes" and a "no"; until then the strategy's own
-   fallback stands. A ``fixed``, ``non-oracle`` or ``oracle`` cut is not moved by answers (only the
-   answered objects change): ``non-oracle`` is a mean over training pairs with no labels to add to,
-   and the other two are given.
+2. **Answers join the evidence of the train-calibrated cut, which moves only as far as they require.**
+   The ``train-calibrated`` cut separates the training objects' leave-one-out scores (relevant ones
+   positive, the others negative). Each answered test object adds its own decision score to that
+   evidence, as a positive ("yes", or naming a relevant training object) or a negative ("no", or naming
+   another one); decision scores are on one scale for test and training objects. The new cut is, among
+   the cuts with the highest balanced accuracy on this evidence, the one nearest the cut without
+   answers (:func:`nearest_best_cut`; candidates lie midway between neighbouring scores of the scene's
+   training and test objects). So an answer the cut already gets right moves nothing, and a "no" above
+   the cut lifts it just past that object, not past the unasked objects above it. (The first rule
+   tried, the widest-gap midpoint of the evidence as without answers, ``move="widest"``, let one hard
+   negative lift the cut past every unasked object up to the lowest relevant training object: on
+   ``gift-paper``'s reading_material, two "no" answers turned five relevant books into distractors.)
+   When the training side gives no positive or no negative (no relevant training object is known), the
+   answers alone place the cut as soon as they hold both a "yes" and a "no"; until then the strategy's
+   own fallback stands. A ``fixed``, ``non-oracle`` or ``oracle`` cut is not moved by answers (only the
+   answered objects change): ``non-oracle`` is a mean over training pairs with no labels to add to, and
+   the other two are given.
 3. **Answers choose among intent candidates.** With several candidates, each one is charged the number
    of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
    fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
@@ -92,6 +98,8 @@ UNKNOWN = ("?", "dont know", "don't know", "unknown", "skip")
 
 #: Name of the kernel's own intent among the candidates (:meth:`QueryProblem.of`).
 PRIMARY = "primary"
+#: How answers move the train-calibrated cut (rule 2): ``nearest`` (adopted), ``widest`` (measured, dropped).
+MOVES = ("nearest", "widest")
 
 
 # ============================================================================= answers
@@ -207,6 +215,11 @@ def _check_strategy(inst: Any, attribute: attrs.Attribute, value: Any) -> None:
         raise GiftError(f"a fixed alignment threshold must be in [0, 1], got {value}")
 
 
+def _check_move(inst: Any, attribute: attrs.Attribute, value: str) -> None:
+    if value not in MOVES:
+        raise GiftError(f"unknown cut move {value!r}; one of {MOVES}")
+
+
 def _check_band(inst: Any, attribute: attrs.Attribute, value: float) -> None:
     if not 0.0 <= float(value) <= 1.0:
         raise GiftError(f"the abstention band must be in [0, 1] (distance to the cut on the decision scale), "
@@ -277,7 +290,8 @@ class QueryProblem:
     order of preference (at least one); ``strategy``: the threshold strategy (see the module docstring
     for which ones answers move); ``trajectories``: the scene's test trajectories ``[N, T, F]`` (one
     batch per scene; empty: one state per object); ``lipschitz``: L of the error bound; ``abstain``: the
-    abstention band on the decision scale (0: never abstain); ``test_labels``: only for the oracle cut.
+    abstention band on the decision scale (0: never abstain); ``test_labels``: only for the oracle cut;
+    ``move``: how answers move the train-calibrated cut (:data:`MOVES`, rule 2).
     """
 
     candidates: Mapping[str, AlignmentScores] = attrs.field(converter=dict)
@@ -286,6 +300,7 @@ class QueryProblem:
     lipschitz: float = attrs.field(default=1.0, converter=float)
     abstain: float = attrs.field(default=0.0, converter=float, validator=_check_band)
     test_labels: Mapping[str, bool] | None = None
+    move: str = attrs.field(default="nearest", validator=_check_move)
 
     def __attrs_post_init__(self) -> None:
         if not self.candidates:
@@ -306,8 +321,8 @@ class QueryProblem:
     @classmethod
     def of(cls, scores: AlignmentScores, strategy: str | float = "train-calibrated", *,
            candidates: Mapping[str, AlignmentScores] | None = None, trajectories: Sequence[FeatureBatch] = (),
-           lipschitz: float = 1.0, abstain: float = 0.0,
-           test_labels: Mapping[str, bool] | None = None) -> "QueryProblem":
+           lipschitz: float = 1.0, abstain: float = 0.0, test_labels: Mapping[str, bool] | None = None,
+           move: str = "nearest") -> "QueryProblem":
         """The problem of one scene: ``scores`` (the kernel's own intent, named :data:`PRIMARY`), then
         ``candidates`` (other intents' scores of the same scene), then the candidates the kernel reported
         in ``scores.details["candidates"]``."""
@@ -316,7 +331,7 @@ class QueryProblem:
             if name in cands:
                 raise GiftError(f"two intent candidates are named {name!r}")
             cands[name] = s
-        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels)
+        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move)
 
     @property
     def test(self) -> tuple[str, ...]:
@@ -337,9 +352,27 @@ def belief(decision: np.ndarray, cut: float) -> np.ndarray:
     return np.clip(np.where(d >= c, above, below), 0.0, 1.0)
 
 
+def nearest_best_cut(positives: Sequence[float], negatives: Sequence[float], anchor: float,
+                     scene: Sequence[float]) -> float:
+    """Among the cuts with the highest balanced accuracy on ``positives`` / ``negatives``, the one nearest
+    ``anchor`` (``anchor`` itself when it is among them). Candidates: midpoints between neighbouring values
+    of the labelled points and the ``scene``'s other scores, points just outside their range, the anchor."""
+    p, n = np.asarray(positives, dtype=float), np.asarray(negatives, dtype=float)
+    if p.size == 0 or n.size == 0:
+        raise GiftError("nearest_best_cut needs at least one positive and one negative score")
+    values = np.unique(np.concatenate([p, n, np.asarray(scene, dtype=float)]))
+    cands = np.concatenate([[values[0] - 1e-6], (values[:-1] + values[1:]) / 2, [values[-1] + 1e-6], [anchor]])
+    bacc = ((p[None, :] >= cands[:, None]).mean(axis=1) + (n[None, :] < cands[:, None]).mean(axis=1)) / 2
+    ok = cands[bacc >= bacc.max() - 1e-12]
+    return float(ok[np.argmin(np.abs(ok - anchor))])
+
+
 def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequence[Answer],
-                 test_labels: Mapping[str, bool] | None = None) -> tuple[float, str]:
-    """``(cut, note)`` of ``strategy`` with the answers as extra labelled points (rule 2 of the module)."""
+                 test_labels: Mapping[str, bool] | None = None, move: str = "nearest") -> tuple[float, str]:
+    """``(cut, note)`` of ``strategy`` with the answers as extra labelled points (rule 2 of the module);
+    ``move``: ``"nearest"`` (the adopted rule) or ``"widest"`` (the widest-gap midpoint, as without answers)."""
+    if move not in MOVES:
+        raise GiftError(f"unknown cut move {move!r}; one of {MOVES}")
     if strategy != "train-calibrated":
         cut, note = scores.threshold(strategy, test_labels)
         known = sum(a.relevant is not None for a in answers)
@@ -357,9 +390,15 @@ def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequen
         neg = scores.loo_scores[usable & ~scores.loo_labels]
     P, N = np.concatenate([pos, yes]), np.concatenate([neg, no])
     if P.size and N.size:
-        cut = float(np.clip(best_separating_cut(P, N), 0.0, 1.0))
-        return cut, (f"leave-one-out over {pos.size} relevant / {neg.size} other training objects and "
-                     f"{len(yes)} yes / {len(no)} no answers")
+        if move == "widest":
+            cut = best_separating_cut(P, N)
+        else:
+            anchor = scores.threshold("train-calibrated")[0]
+            scene = np.concatenate([scores.decision, scores.loo_scores if scores.loo_scores is not None else []])
+            cut = nearest_best_cut(P, N, anchor, scene[scene > NEVER])
+        return float(np.clip(cut, 0.0, 1.0)), (f"leave-one-out over {pos.size} relevant / {neg.size} other "
+                                               f"training objects and {len(yes)} yes / {len(no)} no answers"
+                                               + (", widest gap" if move == "widest" else ""))
     cut, note = scores.threshold("train-calibrated")
     return cut, note + f"; the {len(yes)} yes / {len(no)} no answers give no second class yet"
 
@@ -434,7 +473,7 @@ class QueryState:
         views = dict(p.candidates) if len(p.candidates) > 1 else views_from_details(self.scores, "terms")
         if len(views) < 2:
             return {}
-        return {name: belief(s.decision, answered_cut(s, p.strategy, self.answers, p.test_labels)[0])
+        return {name: belief(s.decision, answered_cut(s, p.strategy, self.answers, p.test_labels, p.move)[0])
                 for name, s in views.items()}
 
     def error_bounds(self) -> np.ndarray:
@@ -487,7 +526,7 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = ()) -> QueryState
     chosen = min(order, key=lambda n: (mistakes[n], order.index(n)))
     scores = problem.candidates[chosen]
     # rule 2: the cut with the answers as labelled points
-    cut, note = answered_cut(scores, problem.strategy, answers, problem.test_labels)
+    cut, note = answered_cut(scores, problem.strategy, answers, problem.test_labels, problem.move)
     base = scores.alignment(cut)
     mapping, kscores = dict(base.mapping), dict(base.scores)
     predicted = scores.decision >= cut

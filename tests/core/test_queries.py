@@ -93,6 +93,24 @@ def test_answers_are_fixed_and_join_the_leave_one_out_evidence_of_the_train_cali
         st3.assume(Answer("q", True))
 
 
+def test_the_cut_moves_only_as_far_as_the_answers_require():
+    # two relevant training objects on top (0.8, 0.78), a hard negative answered "no" at 0.6, unasked
+    # relevant test objects at 0.7 and 0.65 between them
+    s = scores_of(test_r={"x": 0.7, "y": 0.6, "z": 0.65, "w": 0.1}, train_r={"a": 0.8, "b": 0.78, "c": 0.3, "d": 0.2})
+    assert s.threshold("train-calibrated")[0] == pytest.approx(0.54)  # the widest gap: (0.3 + 0.78) / 2
+    no = [Answer("y", False)]
+    nearest = resolve(QueryProblem.of(s), no)
+    assert nearest.cut == pytest.approx(0.625)  # just past y, below z (0.65)
+    assert nearest.predicted.tolist() == [True, False, True, False]
+    widest = resolve(QueryProblem.of(s, move="widest"), no)
+    assert widest.cut == pytest.approx(0.69) and widest.predicted.tolist() == [True, False, False, False]
+    # an answer the cut already gets right moves nothing
+    assert resolve(QueryProblem.of(s), [Answer("w", False), Answer("x", True)]).cut == pytest.approx(0.54)
+    assert resolve(QueryProblem.of(s, move="widest"), [Answer("x", True)]).cut == pytest.approx(0.5)
+    with pytest.raises(GiftError, match="unknown cut move 'far'"):
+        QueryProblem.of(s, move="far")
+
+
 def test_answers_do_not_move_fixed_or_non_oracle_cuts_but_still_fix_the_answered_objects():
     s = scores_of()
     for strategy in (0.5, "non-oracle"):
@@ -232,11 +250,13 @@ def test_error_bound_policy_weighs_the_objects_by_their_presence_in_the_scenes_t
     st = resolve(QueryProblem.of(s))
     assert st.error_bound() == pytest.approx(0.1 + 0.45)
     pr = pol.priority(st, np.random.default_rng(0))
-    # z (0.45, p = 0.45): "yes" -> cut 0.375, bound 0.55; "no" -> cut 0.575 drops y, bound 0.1
-    assert pr[2] == pytest.approx(0.55 - (0.45 * 0.55 + 0.55 * 0.1))
-    # y (0.55, p = 0.55): "yes" -> cut 0.425 takes z in (0.1 + 0.55); "no" -> cut 0.625, bound 0.1
-    assert pr[1] == pytest.approx(0.55 - (0.55 * 0.65 + 0.45 * 0.1))
-    assert pol.choose(st, np.random.default_rng(0)) == "z"
+    # y (0.55): "yes" keeps the cut and vouches for y (bound 0.1); "no" lifts the cut past it (bound 0.1)
+    assert pr[1] == pytest.approx(0.45)
+    # x (0.9): either answer leaves the cut and removes x's 0.1
+    assert pr[0] == pytest.approx(0.1)
+    # z (0.45): "yes" lowers the cut to 0.375 (y stays aligned, bound 0.55); "no" keeps it: nothing gained
+    assert pr[2] == pytest.approx(0.0) and pr[3] == pytest.approx(0.0)
+    assert pol.choose(st, np.random.default_rng(0)) == "y"
     # trajectories where only x is ever near: asking about y cannot lower their bound
     specs = [FeatureSpec(f"{o}_near", subject=o) for o in TEST]
     values = np.zeros((3, 5, 4))

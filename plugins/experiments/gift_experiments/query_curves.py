@@ -87,10 +87,10 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
 
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
-            grid: Sequence[int] = K_GRID) -> list[QueryState]:
+            grid: Sequence[int] = K_GRID, move: str = "nearest") -> list[QueryState]:
     """The states after k questions for each k of ``grid`` (the last state when every object was asked)."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
-    problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band)
+    problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move)
     states = list(asking(problem, policy, labels_answerer(data.labels), max(grid), seed=seed))
     return [states[min(k, len(states) - 1)] for k in grid]
 
@@ -122,9 +122,10 @@ def _aggregate(per_intent: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
 
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
-             bands: Sequence[float] = BANDS) -> dict[str, Any]:
+             bands: Sequence[float] = BANDS, move: str = "nearest") -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
-    at k = 0 for each band. Returns ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention"}``."""
+    at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`). Returns
+    ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention"}``."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
     for policy in POLICIES + (BASELINE,):
@@ -132,7 +133,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
         runs = []  # per seed: [per k: aggregate]
         by_intent: dict[str, list] = {d.intent: [] for d in data}
         for seed in seeds:
-            outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid)] for d in data}
+            outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid, move=move)]
+                        for d in data}
             runs.append([_aggregate({i: o[k] for i, o in outcomes.items()}) for k in range(len(grid))])
             for i, o in outcomes.items():
                 by_intent[i].append(o)
@@ -152,11 +154,11 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
                               for i, runs_i in by_intent.items()}
     for policy in POLICIES:  # which objects each deterministic policy asked about, in order, per intent
         for d in data:
-            last = session(d, policy, 0, grid=(max(grid),))[0]
+            last = session(d, policy, 0, grid=(max(grid),), move=move)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     abstention = {}
     for band in bands:
-        outs = {d.intent: outcome(d, session(d, POLICIES[0], 0, band, grid=(0,))[0]) for d in data}
+        outs = {d.intent: outcome(d, session(d, POLICIES[0], 0, band, grid=(0,), move=move)[0]) for d in data}
         abstention[str(band)] = _aggregate(outs)
     return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention}
 
