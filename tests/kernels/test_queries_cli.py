@@ -3,6 +3,7 @@ again) and `gift evaluate-alignment --queries N` answered from the suite's label
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import subprocess
@@ -30,7 +31,8 @@ def gift_align(args, stdin, answers):
     return p.returncode, p.stdout, p.stderr
 
 
-def test_gift_align_asks_on_the_terminal_saves_the_answers_and_a_rerun_does_not_ask_again(tmp_path):
+def test_gift_align_asks_on_the_terminal_saves_the_answers_and_a_rerun_does_not_ask_again(tmp_path, monkeypatch,
+                                                                                          capsys):
     answers = tmp_path / "answers.json"
     # the first question gets a reply it cannot understand, then a valid one; the second names a training object
     code, out, err = gift_align(["--ask", "2", "--json"], "maybe\nn\nsketchbook\n", answers)
@@ -54,12 +56,17 @@ def test_gift_align_asks_on_the_terminal_saves_the_answers_and_a_rerun_does_not_
     assert code == 0, err2
     assert "question" not in err2 and "using 2 saved answer(s)" in err2
     assert json.loads(out2)["alignment"] == res["alignment"]
-    # a larger budget asks only the new question; end of input stops with the answers kept
-    code, out3, err3 = gift_align(["--ask", "3"], "", answers)
-    assert code == 1 and "question 1 of 1" in err3 and "no answer on stdin" in err3
+    # in this process from here on: a larger budget asks only the new question; end of input stops with the
+    # answers kept
+    args = ALIGN[3:] + ["--answers", str(answers)]
+    monkeypatch.setattr(sys, "stdin", io.StringIO(""))
+    assert main(args + ["--ask", "3"]) == 1
+    err3 = capsys.readouterr().err
+    assert "question 1 of 1" in err3 and "no answer on stdin" in err3
     assert len(json.loads(answers.read_text())["scenes"][next(iter(saved["scenes"]))]["answers"]) == 2
-    code, out4, err4 = gift_align(["--ask", "3", "--abstain", "0.5"], "?\n", answers)
-    assert code == 0, err4
+    monkeypatch.setattr(sys, "stdin", io.StringIO("?\n"))
+    assert main(args + ["--ask", "3", "--abstain", "0.5"]) == 0
+    out4 = capsys.readouterr().out
     assert "answers used: 3" in out4 and "[abstained: held out like a distractor]" in out4
     assert "[answered: don't know]" in out4
 
