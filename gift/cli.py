@@ -10,12 +10,14 @@ import sys
 from collections.abc import Sequence
 
 from gift.core.errors import GiftError
+from gift.core.interfaces import DEFAULT_LM_TIMEOUT_S, LM_TIMEOUT_ENV
+from gift.core.redaction import redact_text
 from gift.plugins.manager import KINDS, get_manager
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
     manager = get_manager()
-    comps = [c for c in manager.components() if c.kind != "command" or args.all]
+    comps = [c for c in manager.components() if c.kind not in ("command", "doctor_check") or args.all]
     if args.json:
         print(json.dumps({"components": [c.as_dict() for c in comps],
                           "failed_plugins": manager.failed}, indent=2))
@@ -75,6 +77,36 @@ def configure_logging(verbose: int = 0, quiet: int = 0) -> int:
     return level
 
 
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
+def _parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """``parser`` and every sub-command parser below it."""
+    out = [parser]
+    for action in parser._actions:  # noqa: SLF001 - argparse keeps sub-parsers only there
+        if isinstance(action, argparse._SubParsersAction):  # noqa: SLF001
+            for sub in dict.fromkeys(action.choices.values()):
+                out += _parsers(sub)
+    return out
+
+
+def add_lm_timeout_argument(parser: argparse.ArgumentParser) -> None:
+    """Give every (sub-)command that takes ``--lm`` also ``--lm-timeout SECONDS`` (sets ``$GIFT_LM_TIMEOUT``)."""
+    for p in _parsers(parser):
+        options = {o for a in p._actions for o in a.option_strings}  # noqa: SLF001
+        if "--lm" in options and "--lm-timeout" not in options:
+            p.add_argument("--lm-timeout", type=_positive_seconds, default=None, metavar="SECONDS",
+                           help=f"give up on a request to an LM server (retries included) after this long "
+                                f"(default: ${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="gift", description="Generalizing Intent for Flexible Test-time rewards",
                                      parents=[_verbosity_parser(False)])
@@ -83,8 +115,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plugins", help="list every registered component by kind, with its distribution",
                        parents=[common])
     p.add_argument("--json", action="store_true", help="machine-readable output")
-    p.add_argument("--all", action="store_true", help="include CLI subcommands contributed by plugins")
+    p.add_argument("--all", action="store_true", help="include CLI subcommands and doctor checks of plugins")
     p.set_defaults(run=_cmd_plugins)
+    from gift import doctor
+
+    d = sub.add_parser("doctor", help="check the install; print what is missing with the command that fixes it",
+                       description=doctor.__doc__.splitlines()[0], parents=[common])
+    doctor.configure(d)
+    d.set_defaults(run=doctor.run)
     for comp in get_manager().components("command"):
         sp = sub.add_parser(comp.name, help=comp.description or None,
                             description=comp.description or None, parents=[common])
@@ -92,6 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
         if configure is not None:
             configure(sp)
         sp.set_defaults(run=comp.factory)
+    add_lm_timeout_argument(parser)
     return parser
 
 
@@ -102,10 +141,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "run", None):
         parser.print_help()
         return 2
+    previous = os.environ.get(LM_TIMEOUT_ENV)
+    if getattr(args, "lm_timeout", None) is not None:  # the environment reaches every worker process too
+        os.environ[LM_TIMEOUT_ENV] = repr(args.lm_timeout)
     try:
         code = args.run(args)
     except GiftError as e:
-        logging.getLogger("gift").error("gift %s: error: %s", args.command, e)
+        logging.getLogger("gift").error("gift %s: error: %s", args.command, redact_text(str(e)))
         return 1
     except KeyboardInterrupt:
         logging.getLogger("gift").error("interrupted")
@@ -113,6 +155,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stderr.close()
         return 0
+    finally:  # main() may be called in-process (tests, scripts): leave the environment as it was
+        if previous is None:
+            os.environ.pop(LM_TIMEOUT_ENV, None)
+        else:
+            os.environ[LM_TIMEOUT_ENV] = previous
     return int(code or 0)
 
 

@@ -94,11 +94,12 @@ def run(args: argparse.Namespace) -> dict:
 
 
 def write(result: dict, md: Path) -> None:
-    from gift.study.stages import write_json_atomic
+    from gift.core.serialization import write_json
     from gift_experiments import query_curves as qc
 
     fig_dir = md.parent / "queries"
-    write_json_atomic(fig_dir / "curves.json", result, indent=1)
+    fig_dir.mkdir(parents=True, exist_ok=True)
+    write_json(fig_dir / "curves.json", result, indent=1)
     sources = list(dict.fromkeys(r["intent_source"] for r in result["runs"].values()))
     figures = {}
     for source in sources:

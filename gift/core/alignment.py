@@ -41,7 +41,9 @@ Thresholds (``threshold=``)
   balanced accuracy; ties: the widest gap). No test label is used. Matrix kernels reuse
   ``K(train, train)`` with the diagonal masked; relevance kernels return the scores from their one
   pass. A relevant object with no relevant partner left is not a usable positive. With no positive or
-  no negative left it falls back to ``non-oracle`` and says so in the note.
+  no negative left it falls back to ``non-oracle`` and says so in the note. A relevance kernel whose
+  scores are calibrated probabilities with the training evidence already folded in
+  (``RelevanceScores.cut``, e.g. gift-prob with ``calibration="pooled"``) gives the cut itself: 1/2.
 - ``"oracle"``: the cut that maximises F1 on the labelled test objects (``test_labels``): an upper bound.
 
 f_ω on trajectories
@@ -249,6 +251,8 @@ class AlignmentScores:
     fallbacks: tuple[str, ...] = ()
     #: JSON-able notes of a relevance kernel's pass (e.g. the category asked about, term weights)
     details: Mapping[str, Any] = attrs.field(factory=dict, eq=False)
+    #: the cut a calibrated relevance kernel's probabilities call for (train-calibrated uses it), or None
+    natural_cut: float | None = None
     relevant_mask: np.ndarray | None = attrs.field(default=None, eq=False)
     #: True when the scores come from a RelevanceKernel (K = relevance in the relevant columns)
     relevance_kernel: bool = False
@@ -261,7 +265,8 @@ class AlignmentScores:
         out: dict[str, Any] = {"test": list(self.test), "train": list(self.train),
                                "relevant_train": list(self.relevant_train), "kernel": self.kernel,
                                "train_mean": self.train_mean, "fallbacks": list(self.fallbacks),
-                               "details": dict(self.details), "relevance_kernel": self.relevance_kernel}
+                               "details": dict(self.details), "relevance_kernel": self.relevance_kernel,
+                               "natural_cut": self.natural_cut}
         for name in self._ARRAYS:
             v = getattr(self, name)
             out[name] = None if v is None else np.asarray(v).tolist()
@@ -281,13 +286,14 @@ class AlignmentScores:
         return cls(test=tuple(d["test"]), train=tuple(d["train"]), relevant_train=tuple(d.get("relevant_train", ())),
                    kernel=d.get("kernel", ""), train_mean=d.get("train_mean"), fallbacks=tuple(d.get("fallbacks", ())),
                    details=dict(d.get("details") or {}), relevance_kernel=bool(d.get("relevance_kernel", False)),
-                   **arrays)
+                   natural_cut=d.get("natural_cut"), **arrays)
 
     def with_relevance(self, relevance: Sequence[float], train_loo: Sequence[float]) -> "AlignmentScores":
         """The same scene scored by other relevances (a term of the kernel, another intent candidate):
         ``relevance`` ``[n_test]`` and ``train_loo`` ``[n_train]`` in [0, 1], with the relevant columns,
         the targets' rule and the thresholds' evidence rebuilt as :func:`score_alignment` builds them.
-        Only for the scores of a relevance kernel."""
+        Only for the scores of a relevance kernel; a view has no natural cut (its scores are not the kernel's
+        calibrated probabilities), so its train-calibrated cut is placed on its training scores."""
         if not self.relevance_kernel or self.relevant_mask is None:
             raise GiftError(f"with_relevance needs the scores of a relevance kernel; {self.kernel!r} gave a matrix")
         r = _check_vector(relevance, len(self.test), self.kernel, "the test objects (view)")
@@ -318,6 +324,9 @@ class AlignmentScores:
                                 "need=('non-oracle',) to score_alignment")
             return self.train_mean, "mean K over training pairs"
         if strategy == "train-calibrated":
+            if self.natural_cut is not None and self.relevant_train:
+                return float(self.natural_cut), ("the kernel's calibrated probabilities (a pooled prior updated with "
+                                                 "the relevant training objects): 1/2")
             if not self.relevant_train:
                 if self.train_mean is None:
                     raise GiftError("the train-calibrated threshold needs the relevant training objects "
@@ -386,7 +395,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         return _relevance_scores(tuple(o.name for o in test), tuple(names), tuple(relevant_train), kname, decision,
                                  train_r, mask, want_train=want_train,
                                  calibrated="train-calibrated" in need and bool(relevant_train),
-                                 details=dict(rs.details), fallbacks=fallbacks)
+                                 details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut)
     train_mean = loo_scores = loo_labels = None
     rows = test + train if want_train else test
     K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
@@ -408,7 +417,8 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
 
 def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_train: tuple[str, ...], kname: str,
                       decision: np.ndarray, train_r: np.ndarray, mask: np.ndarray, *, want_train: bool,
-                      calibrated: bool, details: Mapping[str, Any], fallbacks: tuple[str, ...]) -> AlignmentScores:
+                      calibrated: bool, details: Mapping[str, Any], fallbacks: tuple[str, ...],
+                      natural_cut: float | None = None) -> AlignmentScores:
     """:class:`AlignmentScores` of one relevance pass (the relevance kernels' rule of the module docstring)."""
     K = np.where(mask[None, :], decision[:, None], 0.0)
     target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
@@ -425,7 +435,7 @@ def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_tr
     return AlignmentScores(test=test, train=train, relevant_train=relevant_train, K=K, decision=decision,
                            target=target, aligned=decision, kernel=kname, train_mean=train_mean,
                            loo_scores=loo_scores, loo_labels=loo_labels, fallbacks=fallbacks, details=dict(details),
-                           relevant_mask=mask.copy(), relevance_kernel=True)
+                           relevant_mask=mask.copy(), relevance_kernel=True, natural_cut=natural_cut)
 
 
 def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:

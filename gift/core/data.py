@@ -457,13 +457,16 @@ class RelevanceScores:
     test objects' scale: what a training-set threshold separates. ``relevant`` ``[n_train]`` bool: the
     training objects the scores treat as relevant (the given ``relevant_train``, or the kernel's own
     guess when none was given). ``details``: JSON-able notes for reports (e.g. the category asked about
-    and the weight of each term).
+    and the weight of each term). ``cut``: see below.
     """
 
     relevance: np.ndarray = attrs.field(converter=_vector, eq=False)
     train_loo: np.ndarray = attrs.field(converter=_vector, eq=False)
     relevant: np.ndarray = attrs.field(converter=lambda v: np.asarray(v, dtype=bool).reshape(-1), eq=False)
     details: Mapping[str, Any] = attrs.field(factory=dict, converter=dict, eq=False)
+    #: The cut the scores call for when they are calibrated probabilities with the intent's training evidence
+    #: already folded in (1/2); None: the train-calibrated cut is placed on the training scores.
+    cut: float | None = None
 
     def __attrs_post_init__(self) -> None:
         for name in ("relevance", "train_loo"):

@@ -127,6 +127,35 @@ class LMBackend(abc.ABC):
         return {"identity": self.identity()}
 
 
+#: Environment variable holding the request timeout of LM backends in seconds (``--lm-timeout`` sets it).
+LM_TIMEOUT_ENV = "GIFT_LM_TIMEOUT"
+#: Request timeout of backends that call a server, when neither an option nor the environment sets one.
+DEFAULT_LM_TIMEOUT_S = 120.0
+
+
+def lm_timeout_s(default: float | None = DEFAULT_LM_TIMEOUT_S) -> float | None:
+    """The request timeout of LM backends in seconds: ``$GIFT_LM_TIMEOUT`` when set, else ``default``.
+
+    A backend that calls a server gives up on a request (retries included) after this long. In-process
+    backends (a model in this process) have nothing that can stall and are bounded by ``max_tokens``.
+    """
+    import os
+
+    raw = os.environ.get(LM_TIMEOUT_ENV, "").strip()
+    if not raw:
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        from gift.core.errors import ValidationError
+
+        raise ValidationError(f"{LM_TIMEOUT_ENV}={raw!r}: the LM request timeout must be a positive number of "
+                              f"seconds")
+    return value
+
+
 class IntentEstimator(abc.ABC):
     """J(D_H, D_¬H): infers the intent behind preferred-vs-default demonstrations."""
 

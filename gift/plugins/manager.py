@@ -14,16 +14,17 @@ from __future__ import annotations
 
 import importlib
 import importlib.metadata
+import inspect
 import os
 import threading
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 import attrs
 import pluggy
 
-from gift.core.errors import PluginError, UnknownComponentError
+from gift.core.errors import ComponentOptionError, PluginError, UnknownComponentError
 from gift.plugins import hookspecs
 
 ENTRY_POINT_GROUP = "gift"
@@ -41,6 +42,7 @@ KINDS: dict[str, str] = {
     "executor": "gift_register_executors",
     "suite": "gift_register_suites",
     "command": "gift_register_commands",
+    "doctor_check": "gift_register_doctor_checks",
 }
 
 BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators", "gift.query_policies")
@@ -63,11 +65,47 @@ class Component:
     extra: dict = attrs.field(factory=dict)
 
     def create(self, **options: Any) -> Any:
+        """``factory(**options)``; options the factory does not take are a :class:`ComponentOptionError`
+        listing the valid ones (checked against its signature before it is called)."""
+        self.check_options(options)
         return self.factory(**options)
+
+    def options(self) -> list[str] | None:
+        """Names of the options the factory takes (None when it takes any keyword or has no signature)."""
+        params = _parameters(self.factory)
+        if params is None or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params):
+            return None
+        return [p.name for p in params
+                if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)]
+
+    def check_options(self, options: Mapping[str, Any]) -> None:
+        """Raise :class:`ComponentOptionError` if ``options`` do not fit the factory's signature."""
+        params = _parameters(self.factory)
+        if params is None:
+            return
+        valid = self.options()
+        unknown = sorted(set(options) - set(valid)) if valid is not None else []
+        what = f"{self.kind} {self.name!r} (plugin {self.plugin!r})"
+        listed = ", ".join(valid) if valid else "none"
+        if unknown:
+            raise ComponentOptionError(f"{what} has no option{'s' if len(unknown) > 1 else ''} "
+                                       f"{', '.join(map(repr, unknown))}; valid options: {listed}")
+        try:
+            inspect.Signature(params).bind(**options)
+        except TypeError as e:  # a required option is missing
+            raise ComponentOptionError(f"{what}: {e}; valid options: {listed}") from None
 
     def as_dict(self) -> dict[str, str]:
         return {"kind": self.kind, "name": self.name, "plugin": self.plugin, "distribution": self.distribution,
                 "description": self.description}
+
+
+def _parameters(factory: Any) -> list[inspect.Parameter] | None:
+    """The parameters ``factory(**options)`` takes (a class: its ``__init__`` without ``self``), or None."""
+    try:
+        return list(inspect.signature(factory).parameters.values())
+    except (TypeError, ValueError):  # builtins and some C extensions have no signature
+        return None
 
 
 def _env_list(var: str) -> set[str] | None:
@@ -84,6 +122,8 @@ class GiftPluginManager:
         self._registry: dict[str, dict[str, Component]] = {k: {} for k in KINDS}
         self._distribution: dict[str, str] = {}
         self.failed: dict[str, str] = {}
+        #: plugin name -> its distribution, for the plugins in :attr:`failed`
+        self.failed_distributions: dict[str, str] = {}
         self._loaded = False
 
     # -------------------------------------------------------------------- loading
@@ -112,6 +152,7 @@ class GiftPluginManager:
                 plugin = ep.load()
             except Exception as e:  # noqa: BLE001 - any import failure of a third-party plugin
                 self.failed[ep.name] = f"{type(e).__name__}: {e}"
+                self.failed_distributions[ep.name] = dist
                 warnings.warn(f"gift plugin {ep.name!r} (distribution {dist!r}, {ep.value}) failed to import and "
                               f"was skipped: {type(e).__name__}: {e}", PluginWarning, stacklevel=2)
                 continue
@@ -135,6 +176,7 @@ class GiftPluginManager:
                     raise
                 except Exception as e:  # noqa: BLE001
                     self.failed[plugin_name] = f"{hook_name}: {type(e).__name__}: {e}"
+                    self.failed_distributions[plugin_name] = self._distribution.get(plugin_name, "?")
                     warnings.warn(f"gift plugin {plugin_name!r}: hook {hook_name} raised {type(e).__name__}: {e}; "
                                   f"its remaining registrations were skipped", PluginWarning, stacklevel=2)
 

@@ -6,7 +6,8 @@ study passes them (the intent's suite entry and object catalog, sizes and seeds,
 and options, the resolved LM identity and its model file's hash), plus :func:`gift.core.provenance.code_version`.
 Change any of them and the stage is recomputed; the old file stays.
 
-Writes are atomic (a temporary file in the same directory, flushed, then renamed). A stage file that
+Writes are strict JSON and atomic (:func:`gift.core.serialization.write_json`); the value a stage returns
+is the one read back, so a fresh run and a resumed one see the same thing (NaN as None). A stage file that
 cannot be read (truncated, not JSON, not a stage) is moved aside as ``*.corrupt`` with a warning naming
 it, and the stage is recomputed.
 """
@@ -23,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from gift.core.provenance import code_version
-from gift.core.serialization import to_jsonable
+from gift.core.serialization import to_jsonable, write_json
 
 log = logging.getLogger(__name__)
 
@@ -32,18 +33,6 @@ def digest(value: Any, n: int = 16) -> str:
     """A stable hash of a JSON-able value (keys sorted)."""
     text = json.dumps(to_jsonable(value, nonfinite="string"), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:n]
-
-
-def write_json_atomic(path: Path, value: Any, *, indent: int | None = None) -> None:
-    """Write strict JSON (NaN/inf as null) through a temporary file in the same directory, then rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(to_jsonable(value, nonfinite="null"), indent=indent, allow_nan=False)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
 
 
 class StageCache:
@@ -72,7 +61,9 @@ class StageCache:
                 return value
         value = fn()
         if path is not None:
-            write_json_atomic(path, {"stage": stage, "inputs": inputs, "code": code_version(), "value": value})
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_json(path, {"stage": stage, "inputs": inputs, "code": code_version(), "value": value}, indent=None)
+            value = json.loads(path.read_text(encoding="utf-8"))["value"]  # a fresh run sees what a resume reads
         return value
 
     def _read(self, path: Path, stage: str) -> Any:

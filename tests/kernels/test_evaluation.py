@@ -75,11 +75,31 @@ def test_cli_evaluate_alignment_json_and_table(tmp_path, capsys):
     assert "nope.yaml" in capsys.readouterr().err
 
 
-def test_cli_align_with_objects_outside_any_catalog(capsys):
+def test_cli_align_refuses_objects_outside_any_catalog_unless_allowed(capsys, tmp_path):
+    # a name no catalog has would silently be a grey 8 cm cube without a description
+    code = main(["align", "--train", "paintbrush", "flibbertigibbet", "--test", "zzyzx_thing", "--kernel", "vision"])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert "unknown objects 'flibbertigibbet', 'zzyzx_thing': not in the catalog of any registered suite" in err
+    assert "--allow-unknown" in err
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "tooth brush", "--kernel", "vision"]) == 1
+    assert "'tooth brush' (did you mean 'toothbrush'" in capsys.readouterr().err
+    # with --suite FILE, only that file's catalog counts
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "molding clay", "--kernel", "language",
+                 "--suite", SUITE]) == 1
+    assert f"unknown object 'molding clay'" in (err := capsys.readouterr().err) and SUITE in err
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "sketchbook", "--relevant", "sketchbook",
+                 "--kernel", "language"]) == 1
+    assert "--relevant ['sketchbook']: not among the --train objects" in capsys.readouterr().err
+
     code = main(["align", "--train", "paintbrush", "sketchbook", "banana", "--test", "toothbrush", "glue stick",
-                 "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json"])
+                 "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json",
+                 "--allow-unknown"])
     assert code == 0
-    out = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    assert "warning: 1 object(s) in no catalog" in captured.err and "glue stick" in captured.err
+    out = json.loads(captured.out)
+    assert out["unknown_objects"]["names"] == ["glue stick"]
     rows = {r["object"]: r for r in out["alignment"]}
     assert rows["toothbrush"]["target"] == "paintbrush" and rows["toothbrush"]["relevant"] is True
     assert out["threshold"] == 0.5 and np.array(out["similarity"]["K"]).shape == (2, 3)

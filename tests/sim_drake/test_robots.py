@@ -46,3 +46,23 @@ def test_local_ik_refines_drake_ik(robot):
     assert err[0] < 1e-5
     assert np.abs(spec.kinematics.fk(q[0])[0] - moved).max() < 1e-5
     assert (q >= spec.kinematics.lower).all() and (q <= spec.kinematics.upper).all()
+
+
+@pytest.mark.parametrize("robot", sorted(ROBOTS))
+def test_reach_from_the_kinematics_agrees_with_drake_ik(robot):
+    """The reach the layouts keep objects within: inside it (less the layout's margin) Drake's IK reaches the
+    point pointing down, in several directions; 3 cm beyond it, it does not."""
+    from gift.core.errors import GiftError
+    from gift_sim_drake.scenes import REACH_MARGIN
+
+    spec = ROBOTS[robot]
+    heights = np.array([0.05, 0.25, 0.35])
+    reach = spec.kinematics.reach_pointing_down(heights, spec.rest)
+    assert (reach > 0.5).all() and (np.diff(reach) <= 0.01).all()  # further down, not less far
+    ik = drake_ik(spec)
+    for z, r in zip(heights, reach):
+        for angle in (-0.6, 0.0, 0.8):
+            direction = np.array([np.cos(angle), np.sin(angle)])
+            ik.solve([*(direction * (r - REACH_MARGIN)), z], spec.rest)
+            with pytest.raises(GiftError, match="no .* configuration"):
+                ik.solve([*(direction * (r + 0.03)), z], spec.rest)

@@ -7,7 +7,8 @@ import logging
 
 import pytest
 
-from gift.study.stages import StageCache, write_json_atomic
+from gift.core.serialization import write_json
+from gift.study.stages import StageCache
 from gift_experiments.report import save_results
 
 
@@ -63,7 +64,7 @@ def test_atomic_strict_json_writes_leave_no_temporary_file_and_write_nan_as_null
     import numpy as np
 
     path = tmp_path / "x.json"
-    write_json_atomic(path, {"auc": float("nan"), "arr": np.array([1.0, np.nan]), "inf": float("inf")})
+    write_json(path, {"auc": float("nan"), "arr": np.array([1.0, np.nan]), "inf": float("inf")})
     text = path.read_text()
     assert "NaN" not in text and "Infinity" not in text
     assert json.loads(text) == {"auc": None, "arr": [1.0, None], "inf": None}

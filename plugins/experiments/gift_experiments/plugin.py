@@ -181,7 +181,7 @@ def _configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
 
 
 def run_evaluate_alignment(args: argparse.Namespace) -> int:
-    from gift.study.stages import write_json_atomic
+    from gift.core.serialization import write_json
     from gift.study.sweeps import evaluate_alignment
     from gift_experiments.report import alignment_report
 
@@ -193,7 +193,7 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
     _check_queries(args)
 
     def write(result: dict) -> None:  # serial: after every kernel x intent, so an interrupted run keeps its numbers
-        write_json_atomic(Path(args.out), result, indent=2)
+        write_json(Path(args.out), result)
 
     stages = Path(args.out).with_suffix(".stages") if args.out else None
     with executor_from_args(args) as executor:

@@ -15,6 +15,9 @@ Results layout of a study (every number of a run; figures read only this; NaN is
      "rq2":    {intent: {kernel: {threshold: {subset: {"f1", "fp", "fn", "fp_rate", "fn_rate", "auc", "n"}}}}},
      "scatter": {intent: {"anchor": name, "points": [{"object", "language", "vision", "relevant"}]}},
      "rq3":    {intent: {kernel: {"objects": [...], "relevant": [...], "mean": [...], "se": [...]}}}}
+
+``results.json`` is strict JSON (:func:`gift.core.serialization.write_json`): a number that is not defined
+(the AUC of a subset whose objects are all relevant or all irrelevant) is ``null``, and the means below skip it.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from gift.core.serialization import finite_values, write_json
 from gift.study.chain import REPORT_SUBSETS
 
 log = logging.getLogger("gift.report")
@@ -50,8 +54,15 @@ def _plt():
     return plt
 
 
+def _num(x: Any) -> float:
+    """A plotted number: ``null`` (None) and missing values are NaN (matplotlib leaves them out)."""
+    return float("nan") if x is None else float(x)
+
+
 def _grouped_bars(ax, groups: list[str], series: list[str], mean: np.ndarray, se: np.ndarray | None) -> None:
     """``mean``/``se``: ``[n_series, n_groups]``."""
+    mean = np.vectorize(_num, otypes=[float])(mean)
+    se = None if se is None else np.vectorize(_num, otypes=[float])(se)
     width = 0.8 / max(len(series), 1)
     x = np.arange(len(groups))
     for k, name in enumerate(series):
@@ -218,7 +229,7 @@ def win_rate_table(results: dict) -> str:
     for intent, per in rq1.items():
         rows.append(f"| {intent} | " + " | ".join(_fmt(per[k]["mean"], per[k]["se"]) if k in per else "–"
                                                   for k in kernels) + " |")
-    means = {k: [per[k]["mean"] for per in rq1.values() if k in per] for k in kernels}
+    means = {k: finite_values(per[k]["mean"] for per in rq1.values() if k in per) for k in kernels}
     rows.append("| **mean** | " + " | ".join(_fmt(float(np.mean(v))) if v else "–" for v in means.values()) + " |")
     return "\n".join(rows)
 
@@ -233,8 +244,8 @@ def f1_table(results: dict, threshold: str, subset: str = "all") -> str:
         cells = []
         for k in kernels:
             m = per.get(k, {}).get(threshold, {}).get(subset)
-            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and m.get("auc") is not None
-                         and not np.isnan(m["auc"]) else (f"{m['f1']:.2f}" if m else "–"))
+            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and finite_values([m.get("auc")])
+                         else (f"{m['f1']:.2f}" if m else "–"))
         rows.append(f"| {intent} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
@@ -253,9 +264,9 @@ def headline_table(runs: dict[str, dict], threshold: str = "train-calibrated") -
     for k in kernels:
         cells = []
         for res in runs.values():
-            wr = [per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per]
-            f1 = [per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
-                  if threshold in per.get(k, {}) and "all" in per[k][threshold]]
+            wr = finite_values(per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per)
+            f1 = finite_values(per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
+                               if threshold in per.get(k, {}) and "all" in per[k][threshold])
             se = float(np.std(wr, ddof=1) / np.sqrt(len(wr))) if len(wr) > 1 else None
             cells += [_fmt(float(np.mean(wr)), se) if wr else "–", _fmt(float(np.mean(f1))) if f1 else "–"]
         rows.append(f"| {k} | " + " | ".join(cells) + " |")
@@ -275,8 +286,6 @@ def save_results(results: dict, out: Path) -> Path:
     """Write ``out/results.json`` atomically as strict JSON (NaN, e.g. the AUC of a one-class subset, is
     ``null``). A results file that holds entries the new one lacks is never lost: it is kept as
     ``results.prev.json`` and a warning names what is missing."""
-    from gift.study.stages import write_json_atomic
-
     path = out / "results.json"
     if path.exists():
         try:
@@ -290,7 +299,7 @@ def save_results(results: dict, out: Path) -> Path:
             shown = ", ".join("/".join(m) for m in missing[:8]) + (" ..." if len(missing) > 8 else "")
             log.warning("%s held results the new run does not have (%s); the old file is kept as %s",
                         path, shown, keep)
-    write_json_atomic(path, results, indent=2)
+    write_json(path, results)
     return path
 
 

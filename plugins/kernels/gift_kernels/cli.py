@@ -10,14 +10,17 @@ objects not answered yet, until N objects of the scene are answered.
 from __future__ import annotations
 
 import argparse
+import difflib
 import json
+import logging
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from gift.core import serialization
+from gift.core.alignment import THRESHOLDS, score_alignment
 from gift.core.data import DISTRACTOR, Intent, ObjectSpec
 from gift.core.errors import GiftError
-from gift.core.alignment import THRESHOLDS, score_alignment
 
 # ----------------------------------------------------------------------------- gift align
 
@@ -33,6 +36,9 @@ def configure_align(p: argparse.ArgumentParser) -> None:
                    help="non-oracle (default; train-calibrated with --ask) | train-calibrated | a number in [0, 1]")
     p.add_argument("--suite", default=None, help="look object descriptions/appearances up in this suite "
                                                  "(default: every registered suite's catalog)")
+    p.add_argument("--allow-unknown", action="store_true",
+                   help="accept object names that no catalog has (they get no description and the default "
+                        "appearance, a grey 8 cm cube; the output lists them). Default: an error")
     p.add_argument("--lm", default=None, help="LM backend for LM kernels (default: the embedded model)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.add_argument("--ask", type=int, default=0, metavar="N",
@@ -46,25 +52,59 @@ def configure_align(p: argparse.ArgumentParser) -> None:
                    help="where --ask saves and finds answers (default: answers.json in the gift cache directory)")
 
 
-def catalog_objects(names: Sequence[str], suite: str | None = None) -> tuple[ObjectSpec, ...]:
-    """ObjectSpecs for names: from ``suite``'s catalog, else any registered suite's; unknown names get a bare spec."""
+def lookup_objects(names: Sequence[str], suite: str | None = None
+                   ) -> tuple[tuple[ObjectSpec, ...], list[str], dict[str, Mapping[str, ObjectSpec]]]:
+    """``(specs, missing, catalogs)``: the catalog entry of each name (from ``suite``'s catalog, else the first
+    registered suite's that has it), the names no catalog has (given a bare spec), and the catalogs searched."""
     from gift.core.suite import load_suite
     from gift.plugins.manager import get_manager
 
-    catalogs = []
+    catalogs: dict[str, Mapping[str, ObjectSpec]] = {}
     if suite is not None:
-        catalogs.append(load_suite(suite).objects)
+        loaded = load_suite(suite)
+        catalogs[loaded.path or suite] = loaded.objects
     else:
         for name in sorted(get_manager().suites()):
             try:
-                catalogs.append(load_suite(name).objects)
+                catalogs[name] = load_suite(name).objects
             except GiftError:
                 continue
-    out = []
+    specs, missing = [], []
     for n in names:
-        found = next((c[n] for c in catalogs if n in c), None)
-        out.append(found if found is not None else ObjectSpec(name=n))
-    return tuple(out)
+        found = next((c[n] for c in catalogs.values() if n in c), None)
+        if found is None:
+            missing.append(n)
+            found = ObjectSpec(name=n)
+        specs.append(found)
+    return tuple(specs), missing, catalogs
+
+
+def catalog_objects(names: Sequence[str], suite: str | None = None, *, allow_unknown: bool = False
+                    ) -> tuple[ObjectSpec, ...]:
+    """ObjectSpecs for names (see :func:`lookup_objects`).
+
+    A name that no catalog has is a :class:`GiftError` naming it, with close matches: a bare name would
+    silently be a grey cube without a description. ``allow_unknown=True`` gives it that bare spec instead.
+    """
+    specs, missing, catalogs = lookup_objects(names, suite)
+    if missing and not allow_unknown:
+        raise unknown_objects_error(missing, catalogs, suite)
+    return specs
+
+
+def unknown_objects_error(missing: Sequence[str], catalogs: Mapping[str, Mapping[str, ObjectSpec]],
+                          suite: str | None) -> GiftError:
+    known = sorted({k for c in catalogs.values() for k in c})
+    hints = []
+    for n in missing:
+        close = difflib.get_close_matches(n, known, n=3)
+        hints.append(f"{n!r} (did you mean {', '.join(map(repr, close))}?)" if close else repr(n))
+    where = (f"the catalog of suite {next(iter(catalogs))}" if suite is not None else
+             f"the catalog of any registered suite ({', '.join(catalogs) or 'none'})")
+    many = len(missing) > 1
+    return GiftError(f"unknown object{'s' if many else ''} {', '.join(hints)}: not in {where}. Add "
+                     f"{'them' if many else 'it'} to a suite file and pass --suite FILE, or pass --allow-unknown "
+                     f"to use bare names (no description, the default appearance: a grey 8 cm cube)")
 
 
 def run_align(args: argparse.Namespace) -> int:
@@ -89,10 +129,20 @@ def run_align(args: argparse.Namespace) -> int:
                             f"got {args.threshold!r}") from None
         if not 0.0 <= threshold <= 1.0:
             raise GiftError(f"--threshold must be in [0, 1], got {threshold}")
+    stray = sorted(set(args.relevant) - set(args.train))
+    if stray:
+        raise GiftError(f"--relevant {stray}: not among the --train objects {list(args.train)}")
+    train, missing_train, catalogs = lookup_objects(args.train, args.suite)
+    test, missing_test, _ = lookup_objects(args.test, args.suite)
+    unknown = missing_train + missing_test
+    if unknown and not args.allow_unknown:
+        raise unknown_objects_error(unknown, catalogs, args.suite)
+    if unknown:
+        logging.getLogger("gift").warning(
+            "gift align: warning: %d object(s) in no catalog, aligned as bare names without a description and "
+            "with the default appearance (a grey 8 cm cube): %s", len(unknown), ", ".join(unknown))
     name, _ = parse_spec(args.kernel)
     kernel = build("kernel", args.kernel, lm=args.lm)
-    train = catalog_objects(args.train, args.suite)
-    test = catalog_objects(args.test, args.suite)
     intent = Intent(text=args.intent, source="given") if args.intent else None
     if getattr(kernel, "uses_intent", False) and intent is None:
         raise GiftError(f"kernel {name!r} reads the intent: pass --intent TEXT")
@@ -120,13 +170,15 @@ def run_align(args: argparse.Namespace) -> int:
         rows.append(row)
     out = {"kernel": args.kernel, "intent": args.intent, "threshold": cut, "threshold_rule": note,
            "error_bound_per_state": alignment.error_bound(), "alignment": rows,
+           "unknown_objects": {"names": unknown, "note": "in no catalog: no description, default appearance "
+                                                         "(grey 8 cm cube)"} if unknown else None,
            "similarity": {"test": list(scores.test), "train": list(scores.train),
                           "K": [[round(float(v), 6) for v in row] for row in scores.K]}}
     if state is not None:
         out["queries"] = {"policy": args.policy, "ask": args.ask, "abstain": args.abstain,
                           "answers_file": str(_answers_path(args)), **state.to_dict()}
     if args.json:
-        print(json.dumps(out, indent=2))
+        print(serialization.dumps(out, indent=2))
         return 0
     print(f"kernel {args.kernel}, threshold {cut:.3f} ({note})")
     width = max(len(o.name) for o in test)
@@ -176,14 +228,13 @@ def load_answers(path: Path, key: str) -> dict[str, dict]:
 
 def save_answer(path: Path, key: str, context: dict, answer) -> None:
     """Add one answer under ``key`` (atomically; other scenes' answers are kept)."""
-    from gift.study.stages import write_json_atomic
-
     doc = {"format": 1, "scenes": {}}
     if path.exists():
         doc = json.loads(path.read_text(encoding="utf-8"))
     entry = doc["scenes"].setdefault(key, {**context, "answers": {}})
     entry["answers"][answer.object] = {"relevant": answer.relevant, "plays": answer.plays}
-    write_json_atomic(path, doc, indent=2)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    serialization.write_json(path, doc, indent=2)
 
 
 def _answer_text(a: dict) -> str:

@@ -6,8 +6,10 @@ For a scene, every family has a finite set of candidate *actions*, each acting o
   (keyframes: pre-grasp, grasp, lift, transit, above the container, place);
 - sweep_spill: push object ``i`` sideways (towards +y or -y) across the table
   (pre-contact, contact, mid-push, end of push, retreat);
-- place_mug: carry the mug from its start to its goal along the straight line or one of several
-  detours (start, lift, three via points, above the goal, place).
+- place_mug: carry the mug from its start to its goal (start, lift, three via points, above the goal,
+  place): low (:data:`CARRY_HEIGHT`), passing each via point on the straight line or
+  :data:`MUG_STEER` to either side of it (27 routes: straight, shifted to one side, bends and S-curves
+  around single objects), or raised over the table (:data:`MUG_RAISED`).
 
 Drake's ``InverseKinematics`` solves each action's nominal keyframes once per scene (cached). Each
 generated trajectory then perturbs its keyframes (start posture, grasp and place points, lift height,
@@ -26,6 +28,7 @@ random so demonstrations cover every relevant object); ``random`` takes a unifor
 
 from __future__ import annotations
 
+import itertools
 import threading
 from collections import OrderedDict
 
@@ -37,7 +40,7 @@ from gift.core.errors import GiftError
 from gift_sim_drake.features import compute_features, resolve_task
 from gift_sim_drake.plant import CONTAINERS, drake_ik, footprint_radius, half_height
 from gift_sim_drake.robots import RobotSpec
-from gift_sim_drake.scenes import FAMILIES, check_family, nominal_target
+from gift_sim_drake.scenes import FAMILIES, check_family, lift_height, nominal_target
 
 N_STEPS = 61
 GENERATORS = ("preferred", "default", "random")
@@ -47,9 +50,28 @@ REFINE_TOLERANCE = 1e-3
 
 PUSH_LENGTH = 0.24
 CARRY_HEIGHT = 0.18
-#: place_mug actions: (lateral offset of the middle via point in m, towards +x; height of the via points in m).
-MUG_DETOURS = ((0.0, CARRY_HEIGHT), (-0.1, CARRY_HEIGHT), (0.12, CARRY_HEIGHT), (0.2, CARRY_HEIGHT),
-               (0.0, 0.38), (-0.1, 0.3), (0.15, 0.3))
+#: place_mug via points, as fractions of the way from the mug's start to its goal.
+MUG_VIAS = (0.25, 0.5, 0.75)
+#: place_mug low carries: at each via point the mug passes on the straight line or this far (m) to either side.
+MUG_STEER = 0.15
+#: place_mug raised carries: (lateral offset of the middle via point in m, towards +x; height of the via points in m).
+MUG_RAISED = ((0.0, 0.38), (-0.1, 0.3), (0.15, 0.3))
+
+
+def mug_routes() -> tuple[tuple[tuple[float, ...], float], ...]:
+    """place_mug routes: ``((lateral offset at each of MUG_VIAS in m, towards +x), height in m)``; the first is
+    the straight low carry (the nominal one), then the other low carries, then the raised ones."""
+    sides = (0.0, -MUG_STEER, MUG_STEER)
+    low = [(offsets, CARRY_HEIGHT) for offsets in itertools.product(sides, repeat=len(MUG_VIAS))]
+    raised = [(tuple(offset * np.sin(np.pi * f) for f in MUG_VIAS), height) for offset, height in MUG_RAISED]
+    return tuple(low + raised)
+
+
+def _route_label(offsets: tuple[float, ...], height: float) -> str:
+    if height == CARRY_HEIGHT and not any(offsets):
+        return "carry the mug straight to the goal"
+    where = "low" if height == CARRY_HEIGHT else f"raised to {height:.2f} m"
+    return f"carry the mug {where}, passing the via points at {'/'.join(f'{o:+.2f}' for o in offsets)} m sideways"
 
 
 @attrs.frozen
@@ -98,7 +120,7 @@ def build_actions(scene: Scene) -> ActionSet:
         above = np.array([c[0], c[1], CONTAINERS[mark]["height"] + 0.08])
         targets = []
         for p in pos:
-            lift = np.array([p[0], p[1], max(p[2] + 0.15, 0.25)])
+            lift = np.array([p[0], p[1], lift_height(p[2])])
             transit = np.array([(p[0] + c[0]) / 2, (p[1] + c[1]) / 2, max(lift[2], above[2]) + 0.03])
             grasp = np.array([p[0], p[1], max(p[2], 0.02)])  # thin objects: keep the fingers off the table
             targets.append([grasp + [0, 0, 0.12], grasp, lift, transit, above, c])
@@ -127,16 +149,16 @@ def build_actions(scene: Scene) -> ActionSet:
     line = goal - start
     normal = np.array([-line[1], line[0], 0.0]) / np.linalg.norm(line[:2])
     normal *= np.sign(normal[0]) or 1.0  # positive offsets point away from the robot (+x)
+    lift = np.array([start[0], start[1], CARRY_HEIGHT])
+    above = np.array([goal[0], goal[1], CARRY_HEIGHT])
+    routes = mug_routes()
     targets, labels = [], []
-    for offset, height in MUG_DETOURS:
-        vias = [start + f * line + np.sin(np.pi * f) * offset * normal for f in (0.25, 0.5, 0.75)]
+    for offsets, height in routes:
+        vias = [start + f * line + offset * normal for f, offset in zip(MUG_VIAS, offsets)]
         vias = [np.array([v[0], v[1], height]) for v in vias]
-        lift = np.array([start[0], start[1], CARRY_HEIGHT])
-        above = np.array([goal[0], goal[1], CARRY_HEIGHT])
         targets.append([start, lift, *vias, above, goal])
-        labels.append("carry the mug straight to the goal" if offset == 0 and height == CARRY_HEIGHT else
-                      f"carry the mug with a detour ({offset:+.2f} m sideways, {height:.2f} m high)")
-    return ActionSet(np.array(targets), (0, 8, 20, 30, 40, 52, 60), np.full(len(MUG_DETOURS), -1), 0, None, False,
+        labels.append(_route_label(offsets, height))
+    return ActionSet(np.array(targets), (0, 8, 20, 30, 40, 52, 60), np.full(len(routes), -1), 0, None, False,
                      tuple(labels), 0)
 
 

@@ -24,6 +24,14 @@ def drake_jaco(**options):
 
 
 @hookimpl
+def gift_register_doctor_checks(register):
+    from gift_sim_drake import doctor
+
+    register("drake", doctor.check_drake, description="pydrake imports")
+    register("EGL", doctor.check_egl, description="EGL libraries for Drake's headless renders")
+
+
+@hookimpl
 def gift_register_simulators(register):
     register("drake-franka", drake_franka, description=drake_franka.__doc__.splitlines()[0])
     register("drake-jaco", drake_jaco, description=drake_jaco.__doc__.splitlines()[0])

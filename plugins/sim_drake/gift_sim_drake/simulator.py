@@ -4,6 +4,7 @@ Drake ``MultibodyPlant`` (scenes, trajectories, features, renders)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
@@ -13,7 +14,7 @@ from gift.core.errors import GiftError
 from gift.core.interfaces import Simulator, Task
 from gift_sim_drake.features import compute_features, resolve_task
 from gift_sim_drake.motion import GENERATORS, N_STEPS, MotionPlanner
-from gift_sim_drake.robots import get_robot
+from gift_sim_drake.robots import RobotSpec, get_robot
 from gift_sim_drake.scenes import FAMILIES, check_family, layout
 
 
@@ -29,10 +30,21 @@ def as_object_specs(objects: Sequence[ObjectSpec | str]) -> tuple[ObjectSpec, ..
     return tuple(out)
 
 
+#: Heights (m) at which an arm's reach is computed; :meth:`DrakeSimulator.reach` interpolates between them.
+REACH_HEIGHTS = np.arange(0.0, 0.81, 0.05)
+
+
+@lru_cache(maxsize=None)
+def _reach_curve(robot: RobotSpec) -> np.ndarray:
+    """The arm's reach with the gripper pointing down at :data:`REACH_HEIGHTS`, from its kinematics (m)."""
+    return robot.kinematics.reach_pointing_down(REACH_HEIGHTS, robot.rest)
+
+
 class DrakeSimulator(Simulator):
     """Tabletop scenes of the four task families for one arm, on Drake.
 
-    - ``make_scene(task, objects, relevant, seed)``: a randomised layout (:mod:`gift_sim_drake.scenes`);
+    - ``make_scene(task, objects, relevant, seed)``: a randomised layout (:mod:`gift_sim_drake.scenes`) whose
+      objects to be picked lie within this arm's :meth:`reach`;
       ``scene.landmarks`` holds the family's landmark (``backpack``/``drawer``: the place point inside the
       container; ``spill``: the spill's centre on the table; ``mug``: the mug's start) and, for place_mug,
       ``mug_goal``.
@@ -57,7 +69,13 @@ class DrakeSimulator(Simulator):
                    seed: int = 0) -> Scene:
         family = resolve_task(task)  # unknown names: UnknownComponentError listing the registered families
         check_family(family.name)
-        return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed))
+        return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed), reach=self.reach)
+
+    def reach(self, heights: np.ndarray) -> np.ndarray:
+        """How far this arm reaches with the gripper pointing down: per height ``[H]`` (m), the largest distance
+        ``[H]`` (m) from the base's vertical axis, from its kinematics
+        (:meth:`~gift_sim_drake.kinematics.ArmKinematics.reach_pointing_down`, computed once per arm)."""
+        return np.interp(np.asarray(heights, dtype=float), REACH_HEIGHTS, _reach_curve(self.robot))
 
     def generate(self, scene: Scene, generator: str = "preferred", n: int = 1, seed: int = 0) -> TrajectoryBatch:
         return self.planner.generate(scene, generator, n, seed)
