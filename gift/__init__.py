@@ -65,6 +65,10 @@ def get_alignment_operator(name: str, **options: Any):
     return get_component("alignment_operator", name, **options)
 
 
+def get_query_policy(name: str, **options: Any):
+    return get_component("query_policy", name, **options)
+
+
 def get_reward_model(name: str, **options: Any):
     return get_component("reward_model", name, **options)
 
@@ -104,5 +108,5 @@ __all__ = [
     "TrajectoryBatch", "Usage", "GiftError", "LMAnswerError", "LMError", "PluginError", "SuiteError",
     "UnknownComponentError", "GiftPipeline", "Suite", "load_suite", "hookimpl", "get_manager", "get_component",
     "get_simulator", "get_task", "get_kernel", "get_intent_estimator", "get_alignment_operator",
-    "get_reward_model", "resolve_lm", "list_components",
+    "get_query_policy", "get_reward_model", "resolve_lm", "list_components",
 ]

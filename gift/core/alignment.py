@@ -229,7 +229,11 @@ class AlignmentScores:
     column of the match;
     ``train_mean``: mean of K over distinct training pairs (None if not computed); ``loo_scores`` /
     ``loo_labels`` ``[m]``: leave-one-out decision scores of the training objects and whether each is
-    relevant (None if not computed).
+    relevant (None if not computed); ``relevant_mask`` ``[m]``: the training columns the decisions treat
+    as relevant (a relevance kernel's own guess when ``relevant_train`` is empty; for a matrix kernel
+    without ``relevant_train`` all False: every column counts; None if not recorded).
+    :meth:`to_dict` / :meth:`from_dict` keep them as JSON, so a scene can be re-thresholded (or re-scored
+    with answers, :mod:`gift.core.queries`) without running the kernel again.
     """
 
     test: tuple[str, ...]
@@ -249,6 +253,55 @@ class AlignmentScores:
     details: Mapping[str, Any] = attrs.field(factory=dict, eq=False)
     #: the cut a calibrated relevance kernel's probabilities call for (train-calibrated uses it), or None
     natural_cut: float | None = None
+    relevant_mask: np.ndarray | None = attrs.field(default=None, eq=False)
+    #: True when the scores come from a RelevanceKernel (K = relevance in the relevant columns)
+    relevance_kernel: bool = False
+
+    _ARRAYS: ClassVar[tuple[str, ...]] = ("K", "decision", "target", "aligned", "loo_scores", "loo_labels",
+                                          "relevant_mask")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able form (arrays as lists); :meth:`from_dict` reads it back."""
+        out: dict[str, Any] = {"test": list(self.test), "train": list(self.train),
+                               "relevant_train": list(self.relevant_train), "kernel": self.kernel,
+                               "train_mean": self.train_mean, "fallbacks": list(self.fallbacks),
+                               "details": dict(self.details), "relevance_kernel": self.relevance_kernel,
+                               "natural_cut": self.natural_cut}
+        for name in self._ARRAYS:
+            v = getattr(self, name)
+            out[name] = None if v is None else np.asarray(v).tolist()
+        return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "AlignmentScores":
+        """Read what :meth:`to_dict` wrote (a GiftError names a missing field)."""
+        missing = [k for k in ("test", "train", "K", "decision", "target", "aligned") if k not in d]
+        if missing:
+            raise GiftError(f"alignment scores: fields {missing} are missing")
+        n, m = len(d["test"]), len(d["train"])
+        dtypes = {"target": np.intp, "loo_labels": bool, "relevant_mask": bool}
+        arrays = {k: (None if d.get(k) is None else np.asarray(d[k], dtype=dtypes.get(k, float)))
+                  for k in cls._ARRAYS}
+        arrays["K"] = arrays["K"].reshape(n, m)
+        return cls(test=tuple(d["test"]), train=tuple(d["train"]), relevant_train=tuple(d.get("relevant_train", ())),
+                   kernel=d.get("kernel", ""), train_mean=d.get("train_mean"), fallbacks=tuple(d.get("fallbacks", ())),
+                   details=dict(d.get("details") or {}), relevance_kernel=bool(d.get("relevance_kernel", False)),
+                   natural_cut=d.get("natural_cut"), **arrays)
+
+    def with_relevance(self, relevance: Sequence[float], train_loo: Sequence[float]) -> "AlignmentScores":
+        """The same scene scored by other relevances (a term of the kernel, another intent candidate):
+        ``relevance`` ``[n_test]`` and ``train_loo`` ``[n_train]`` in [0, 1], with the relevant columns,
+        the targets' rule and the thresholds' evidence rebuilt as :func:`score_alignment` builds them.
+        Only for the scores of a relevance kernel; a view has no natural cut (its scores are not the kernel's
+        calibrated probabilities), so its train-calibrated cut is placed on its training scores."""
+        if not self.relevance_kernel or self.relevant_mask is None:
+            raise GiftError(f"with_relevance needs the scores of a relevance kernel; {self.kernel!r} gave a matrix")
+        r = _check_vector(relevance, len(self.test), self.kernel, "the test objects (view)")
+        t = _check_vector(train_loo, len(self.train), self.kernel, "the held-out training objects (view)")
+        return _relevance_scores(self.test, self.train, self.relevant_train, self.kernel, r, t, self.relevant_mask,
+                                 want_train=self.train_mean is not None,
+                                 calibrated=self.loo_scores is not None, details=self.details,
+                                 fallbacks=self.fallbacks)
 
     def threshold(self, strategy: str | float, test_labels: Mapping[str, bool] | None = None
                   ) -> tuple[float, str]:
@@ -331,8 +384,6 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
     need = set(need)
     want_train = ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1
     n_fallbacks = len(getattr(kernel, "fallbacks", ()))
-    train_mean = loo_scores = loo_labels = natural_cut = None
-    details: dict[str, Any] = {}
     if isinstance(kernel, RelevanceKernel):
         rs = kernel.score(test, train, intent, tuple(relevant_train))
         decision = _check_vector(rs.relevance, len(test), kernel, "the test objects")
@@ -340,36 +391,51 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         mask = np.asarray(rs.relevant, dtype=bool)
         if mask.shape != (len(train),):
             raise GiftError(f"kernel {kname!r}: RelevanceScores.relevant must be [{len(train)}] booleans")
-        K = np.where(mask[None, :], decision[:, None], 0.0)
-        target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
-        aligned = decision
-        details = dict(rs.details)
-        natural_cut = rs.cut
-        if want_train:
-            Ktt = np.where(mask[None, :], train_r[:, None], 0.0)
-            train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
-            if "train-calibrated" in need and relevant_train:
-                loo_labels = rel_mask.copy()
-                # a relevant object with no relevant partner left cannot be scored as a positive
-                lonely = rel_mask & (rel_mask.sum() < 2)
-                loo_scores = np.where(lonely, NEVER, train_r)
-    else:
-        rows = test + train if want_train else test
-        K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
-                              "the test objects" + (" and the training objects" if want_train else ""))
-        K, Ktt = K_all[:len(test)], (K_all[len(test):] if want_train else None)
-        decision, target = matrix_decision(K, rel_mask)
-        aligned = K[np.arange(len(test)), target] if len(train) else np.zeros(len(test))
-        if Ktt is not None:
-            train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
-            if "train-calibrated" in need and relevant_train:
-                loo_labels = rel_mask.copy()
-                loo_scores, _ = matrix_decision(Ktt, rel_mask, valid=~np.eye(len(train), dtype=bool))
+        fallbacks = tuple(getattr(kernel, "fallbacks", ()))[n_fallbacks:]
+        return _relevance_scores(tuple(o.name for o in test), tuple(names), tuple(relevant_train), kname, decision,
+                                 train_r, mask, want_train=want_train,
+                                 calibrated="train-calibrated" in need and bool(relevant_train),
+                                 details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut)
+    train_mean = loo_scores = loo_labels = None
+    rows = test + train if want_train else test
+    K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
+                          "the test objects" + (" and the training objects" if want_train else ""))
+    K, Ktt = K_all[:len(test)], (K_all[len(test):] if want_train else None)
+    decision, target = matrix_decision(K, rel_mask)
+    aligned = K[np.arange(len(test)), target] if len(train) else np.zeros(len(test))
+    if Ktt is not None:
+        train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
+        if "train-calibrated" in need and relevant_train:
+            loo_labels = rel_mask.copy()
+            loo_scores, _ = matrix_decision(Ktt, rel_mask, valid=~np.eye(len(train), dtype=bool))
     fallbacks = tuple(getattr(kernel, "fallbacks", ()))[n_fallbacks:]  # LM answers completed by default
     return AlignmentScores(test=tuple(o.name for o in test), train=tuple(names),
                            relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
                            aligned=aligned, kernel=kname, train_mean=train_mean, loo_scores=loo_scores,
-                           loo_labels=loo_labels, fallbacks=fallbacks, details=details, natural_cut=natural_cut)
+                           loo_labels=loo_labels, fallbacks=fallbacks, relevant_mask=rel_mask)
+
+
+def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_train: tuple[str, ...], kname: str,
+                      decision: np.ndarray, train_r: np.ndarray, mask: np.ndarray, *, want_train: bool,
+                      calibrated: bool, details: Mapping[str, Any], fallbacks: tuple[str, ...],
+                      natural_cut: float | None = None) -> AlignmentScores:
+    """:class:`AlignmentScores` of one relevance pass (the relevance kernels' rule of the module docstring)."""
+    K = np.where(mask[None, :], decision[:, None], 0.0)
+    target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
+    train_mean = loo_scores = loo_labels = None
+    if want_train:
+        Ktt = np.where(mask[None, :], train_r[:, None], 0.0)
+        train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
+        if calibrated:
+            rel_mask = np.array([n in set(relevant_train) for n in train], dtype=bool)
+            loo_labels = rel_mask.copy()
+            # a relevant object with no relevant partner left cannot be scored as a positive
+            lonely = rel_mask & (rel_mask.sum() < 2)
+            loo_scores = np.where(lonely, NEVER, train_r)
+    return AlignmentScores(test=test, train=train, relevant_train=relevant_train, K=K, decision=decision,
+                           target=target, aligned=decision, kernel=kname, train_mean=train_mean,
+                           loo_scores=loo_scores, loo_labels=loo_labels, fallbacks=fallbacks, details=dict(details),
+                           relevant_mask=mask.copy(), relevance_kernel=True, natural_cut=natural_cut)
 
 
 def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:

@@ -10,6 +10,7 @@ f_ω(s') = argmax_s K(s, s' | ω)            :meth:`AlignmentOperator.align`
 f_ω(ξ') (semantic components only)         :func:`gift.core.alignment.align_features`
 R_θ(ξ)                                     :meth:`RewardModel.score`
 R̃_θ(ξ' | ω) = R_θ(f_ω(ξ'))                 :meth:`RewardModel.score_aligned`
+ask the human instead of guessing          :meth:`QueryPolicy.choose` (:mod:`gift.core.queries`)
 =========================================  ============================================
 
 Every method is batch-first: it takes many trajectories (or objects) per call.
@@ -20,7 +21,7 @@ from __future__ import annotations
 import abc
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -37,6 +38,10 @@ from gift.core.data import (
     Scene,
     TrajectoryBatch,
 )
+from gift.core.errors import GiftError
+
+if TYPE_CHECKING:
+    from gift.core.queries import QueryState
 
 
 class Task(abc.ABC):
@@ -210,6 +215,40 @@ class AlignmentOperator(abc.ABC):
     def align(self, kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
               intent: Intent | None = None, *, relevant_train: Sequence[str] = ()) -> Alignment:
         """Map every test object to a training object or DISTRACTOR."""
+
+
+class QueryPolicy(abc.ABC):
+    """Chooses which test object to ask the human about next ("is it part of the goal?").
+
+    A policy sees a :class:`~gift.core.queries.QueryState`: the scene's alignment scores (of every intent
+    candidate, when there are several), the current cut, the answers so far and, where the scene's test
+    trajectories are known, their error bounds. :func:`gift.core.queries.asking` asks the object
+    :meth:`choose` returns, re-scores the scene with the answer and asks again.
+    """
+
+    name: ClassVar[str]
+
+    @abc.abstractmethod
+    def priority(self, state: QueryState, rng: np.random.Generator) -> np.ndarray:
+        """``[n_test]``: how much an answer about each test object is worth now (higher is asked first).
+        Values of objects already asked are ignored. ``rng``: the session's generator (random policies)."""
+
+    def choose(self, state: QueryState, rng: np.random.Generator) -> str | None:
+        """The object to ask about next, or None when every object was asked.
+
+        The highest :meth:`priority` among the objects not yet asked; ties go to the object whose decision
+        score is nearest the cut, then to the first in the scene's order (both compared at 12 decimals).
+        """
+        askable = np.flatnonzero(~state.asked)
+        if askable.size == 0:
+            return None
+        pr = np.asarray(self.priority(state, rng), dtype=float).reshape(-1)
+        if pr.shape != (len(state.test),) or not np.all(np.isfinite(pr[askable])):
+            raise GiftError(f"query policy {self.name!r} returned {pr.shape} priorities (finite values needed for "
+                            f"the {askable.size} objects not yet asked) for {len(state.test)} test objects")
+        dist = np.round(np.abs(state.scores.decision - state.cut), 12)
+        order = np.lexsort((askable, dist[askable], -np.round(pr[askable], 12)))
+        return state.test[int(askable[order[0]])]
 
 
 class RewardModel(abc.ABC):

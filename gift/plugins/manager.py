@@ -36,6 +36,7 @@ KINDS: dict[str, str] = {
     "kernel": "gift_register_kernels",
     "intent_estimator": "gift_register_intent_estimators",
     "alignment_operator": "gift_register_alignment_operators",
+    "query_policy": "gift_register_query_policies",
     "reward_model": "gift_register_reward_models",
     "lm_backend": "gift_register_lm_backends",
     "executor": "gift_register_executors",
@@ -44,7 +45,7 @@ KINDS: dict[str, str] = {
     "doctor_check": "gift_register_doctor_checks",
 }
 
-BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators")
+BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators", "gift.query_policies")
 
 
 class PluginWarning(UserWarning):

@@ -13,6 +13,7 @@
                                              │
                       per kernel: K(s, s'|ω) on the test objects -> cut -> f_ω        core/alignment.py
                       (RQ2: precision/recall/F1/AUC per threshold and confound subset)
+                      optional: k queries answered by the simulated human, abstention   core/queries.py
                                              │
                       RQ1: win rate of R_θ(f_ω(ξ')) on test scenes;  RQ3: Boltzmann over candidates
 
@@ -72,6 +73,11 @@ def _thresholds(inst: Any, attribute: attrs.Attribute, value: tuple) -> None:
         raise GiftError(f"unknown threshold(s) {bad or '(none given)'}; choose from {list(THRESHOLDS)}")
 
 
+def _band(inst: Any, attribute: attrs.Attribute, value: float) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+        raise GiftError(f"study option {attribute.name} must be a number in [0, 1], got {value!r}")
+
+
 def _source(inst: Any, attribute: attrs.Attribute, value: str) -> None:
     if value not in INTENT_SOURCES:
         raise GiftError(f"unknown intent source {value!r}; choose from {list(INTENT_SOURCES)}")
@@ -88,7 +94,10 @@ class StudyConfig:
     kernels that take them; ``sanity_reps`` repeated inferences (temperature 0.7) for the intent cosine.
     ``rq1=False`` stops after the alignments (what ``evaluate-alignment`` needs). ``demonstrations``: a
     directory of saved training sets (``<intent id>.npz/.json``, :func:`gift.study.scenes.save_training_set`)
-    to use instead of simulating the human.
+    to use instead of simulating the human. ``queries``: questions per intent and kernel that the simulated
+    human (the suite's labels) answers, chosen by the registered ``query_policy``; ``abstain``: the
+    abstention band around the cut (:mod:`gift.core.queries`); with either, each kernel gets a second row
+    (:func:`query_label`) in RQ1 and RQ2.
     """
 
     suite: str = "gift-paper"
@@ -115,6 +124,9 @@ class StudyConfig:
     rq3: bool = True
     rq3_robot: str = "franka"
     demonstrations: str | None = None
+    queries: int = attrs.field(default=0, validator=_non_negative)
+    query_policy: str = "uncertainty"
+    abstain: float = attrs.field(default=0.0, validator=_band)
 
     def key(self) -> str:
         """A short hash of the configuration (names the run in the manifest)."""
@@ -285,12 +297,14 @@ def score_intent(kernel: Any, suite: Suite, spec: IntentSpec, intent: Intent | N
 def alignment_record(scores: AlignmentScores, cuts: Mapping[str, tuple[float, str]], metrics: Mapping,
                      seconds: float) -> dict[str, Any]:
     """The JSON record of one kernel on one intent: per threshold the cut, its note, the mapping and
-    metrics; per object its decision score and matched training object; fallbacks and kernel details."""
+    metrics; per object its decision score and matched training object; fallbacks and kernel details;
+    ``scores`` (:meth:`AlignmentScores.to_dict`, to re-threshold or ask queries without the kernel)."""
     out: dict[str, Any] = {"thresholds": {}, "seconds": round(seconds, 3), "fallbacks": list(scores.fallbacks),
                            "details": dict(scores.details), "relevant_train": list(scores.relevant_train),
                            "objects": {name: {"decision": float(scores.decision[i]),
                                               "match": scores.train[scores.target[i]] if scores.train else None}
-                                       for i, name in enumerate(scores.test)}}
+                                       for i, name in enumerate(scores.test)},
+                           "scores": scores.to_dict()}
     for thr, (cut, note) in cuts.items():
         al = scores.alignment(cut)
         out["thresholds"][thr] = {"cut": cut, "note": note, "mapping": dict(al.mapping), "scores": dict(al.scores),
@@ -323,6 +337,36 @@ def align_stage(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSp
     return cache.get_or_compute(spec.id, f"align-{kernel_spec}", inputs, compute)
 
 
+def query_label(kernel_spec: str, cfg: StudyConfig) -> str:
+    """The row of a kernel after queries and abstention, e.g. ``gift-prob +2q uncertainty``."""
+    label = f"{kernel_spec} +{cfg.queries}q {cfg.query_policy}" if cfg.queries else kernel_spec
+    return label + (f" abstain {cfg.abstain:g}" if cfg.abstain else "")
+
+
+def query_threshold(cfg: StudyConfig) -> str:
+    """The threshold queries re-score: ``train-calibrated`` when the study has it (answers move only that
+    cut, :mod:`gift.core.queries`), else the study's first."""
+    return "train-calibrated" if "train-calibrated" in cfg.thresholds else cfg.thresholds[0]
+
+
+def query_stage(cfg: StudyConfig, spec: IntentSpec, scores: AlignmentScores,
+                trajectories: Sequence[FeatureBatch] = ()) -> dict[str, Any]:
+    """Up to ``cfg.queries`` questions about the intent's test objects, chosen by ``cfg.query_policy`` and
+    answered from the suite's labels (the simulated human), abstaining within ``cfg.abstain`` of the cut
+    of :func:`query_threshold`; no kernel runs again (:mod:`gift.core.queries`). ``trajectories``: the test
+    scenes' features, for the error bound. Returns :meth:`QueryState.to_dict` with the policy and the
+    metrics per subset (``{threshold: {subset: ...}}``)."""
+    from gift.core.queries import QueryProblem, ask, labels_answerer
+
+    labels, th = test_labels(spec), query_threshold(cfg)
+    problem = QueryProblem.of(scores, th, trajectories=trajectories, abstain=cfg.abstain,
+                              test_labels=labels if th == "oracle" else None)
+    state = ask(problem, cfg.query_policy, labels_answerer(labels), cfg.queries, seed=stable_seed("queries", spec.id))
+    metrics = alignment_metrics(state.decision, [t.relevant for t in spec.test], subset_masks(spec), {th: state.cut})
+    return {"policy": cfg.query_policy, "queries": cfg.queries, "abstain": cfg.abstain, "threshold": th,
+            **state.to_dict(), "metrics": metrics}
+
+
 def oracle_alignment(spec: IntentSpec) -> Alignment:
     """Every relevant test object to the first relevant training object, the rest to DISTRACTOR (labels)."""
     target = spec.relevant_train[0] if spec.relevant_train else DISTRACTOR
@@ -330,12 +374,13 @@ def oracle_alignment(spec: IntentSpec) -> Alignment:
     return Alignment(mapping, {k: 1.0 if v != DISTRACTOR else 0.0 for k, v in mapping.items()}, kernel=ORACLE)
 
 
-def win_rates(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec, reward: Any,
-              alignments: Mapping[str, Alignment], seeds: Sequence[int], progress: Progress) -> dict[str, dict]:
-    """RQ1: pairwise win rate of R_θ(f_ω(ξ')) against the human's reward on test scenes, per alignment."""
+def rq1_scenes(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec, seeds: Sequence[int],
+               progress: Progress) -> list[tuple[FeatureBatch, np.ndarray, np.ndarray]]:
+    """The RQ1 test scenes of one intent, one per seed: the features ``[N, T, F]`` of its preferred,
+    default and random trajectories, the human's reward ``[N]`` and the sampled pairs ``[P, 2]``."""
     sim = comp.simulator(simulator_name(cfg.robot))
     task = comp.task(spec.task)
-    per: dict[str, list[float]] = {}
+    out = []
     for seed in progress(seeds, f"{spec.id}: RQ1 seeds"):
         scene = test_scene(sim, suite, spec, cfg.test_objects_per_scene, seed)
         specs = task.feature_specs(scene.object_names)
@@ -343,7 +388,19 @@ def win_rates(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec
             sim.features(sim.generate(scene, g, cfg.trajectories_per_generator, stable_seed(seed, g)),
                          spec.task).reindex(specs) for g in ("preferred", "default", "random")])
         truth = task.ground_truth_reward(feats, sorted(scene.relevant))
-        pairs_idx = sample_pairs(len(feats), cfg.pairs, np.random.default_rng(seed))
+        out.append((feats, truth, sample_pairs(len(feats), cfg.pairs, np.random.default_rng(seed))))
+    return out
+
+
+def win_rates(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec, reward: Any,
+              alignments: Mapping[str, Alignment], seeds: Sequence[int], progress: Progress,
+              scenes: Sequence[tuple[FeatureBatch, np.ndarray, np.ndarray]] | None = None) -> dict[str, dict]:
+    """RQ1: pairwise win rate of R_θ(f_ω(ξ')) against the human's reward on test scenes, per alignment
+    (``scenes``: :func:`rq1_scenes`, made here when not given)."""
+    if scenes is None:
+        scenes = rq1_scenes(comp, cfg, suite, spec, seeds, progress)
+    per: dict[str, list[float]] = {}
+    for feats, truth, pairs_idx in scenes:
         for kname, al in alignments.items():
             per.setdefault(kname, []).append(pairwise_win_rate(reward.score_aligned(feats, al), truth, pairs_idx))
     return {k: {"mean": mean_se(v)[0], "se": mean_se(v)[1], "per_seed": v} for k, v in per.items()}
@@ -463,6 +520,18 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
         aligned[kspec] = Alignment(t["mapping"], t["scores"], t["cut"], kernel=kspec)
         if rec["fallbacks"]:
             errors.append(f"{spec.id}/{kspec}: LM answers completed by default: {'; '.join(rec['fallbacks'])}")
+    scenes = timed("rq1", lambda: rq1_scenes(comp, cfg, suite, spec, job.seeds["rq1"], progress)) if cfg.rq1 else None
+
+    # ---- queries to the simulated human and abstention (no kernel runs again)
+    if cfg.queries or cfg.abstain:
+        for kspec, rec in list(results["alignment"].get(spec.id, {}).items()):
+            label = query_label(kspec, cfg)
+            say(f"[{spec.id}] {label}: asking the simulated human")
+            q = timed("queries", lambda: query_stage(cfg, spec, AlignmentScores.from_dict(rec["scores"]),
+                                                     [f for f, _, _ in scenes or ()]))
+            rec["queries"] = q
+            results["rq2"][spec.id][label] = {q["threshold"]: q["metrics"][q["threshold"]]}
+            aligned[label] = Alignment(q["mapping"], q["scores"], q["cut"], kernel=label)
     if not cfg.rq1:
         return _slice(results, errors, timing, comp, usage_before, lines)
     aligned[ORACLE] = oracle_alignment(spec)
@@ -470,7 +539,7 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
     # ---- RQ1
     say(f"[{spec.id}] RQ1 win rates on {cfg.seeds} test scenes")
     results["rq1"][spec.id] = timed("rq1", lambda: win_rates(comp, cfg, suite, spec, reward, aligned,
-                                                             job.seeds["rq1"], progress))
+                                                             job.seeds["rq1"], progress, scenes))
 
     # ---- scatter (language vs vision similarity to the first relevant training object)
     names = {parse_spec(k)[0]: k for k in kernels}

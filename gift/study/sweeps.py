@@ -49,6 +49,8 @@ from gift.study.chain import (
     run_intent,
     score_intent,
     alignment_record,
+    query_stage,
+    query_threshold,
     subset_masks,
 )
 from gift.study.components import check_spec, components_for
@@ -305,6 +307,10 @@ def _lm_delta(comp: Any, before: dict | None) -> dict | None:
 
 def _done_line(kernel: str, intent_id: str, record: Mapping[str, Any], seconds: float) -> str:
     f1 = " ".join(f"{t}={r['metrics']['all']['f1']:.2f}" for t, r in record["thresholds"].items())
+    q = record.get("queries")
+    if q:
+        f1 += (f", after {q['asked']} queries ({q['policy']}) {q['metrics'][q['threshold']]['all']['f1']:.2f}"
+               + (f", {q['n_abstained']} abstained" if q["abstain"] else ""))
     return f"{kernel} / {intent_id}: F1 {f1} ({seconds:.1f}s)"
 
 
@@ -333,6 +339,8 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
             intent, relevant = item.front.intent, item.front.relevant
         try:
             scores, cuts, metrics = score_intent(kernel, suite, spec, intent, relevant.names, cfg.thresholds)
+            # the simulated human answers (no trajectories here: the error bound counts one state per object)
+            queried = query_stage(cfg, spec, scores) if cfg.queries or cfg.abstain else None
         except Exception as e:  # noqa: BLE001 - one failing intent must not lose the others
             failure = Failure.current(e)
             out = ItemOutcome(item.kernel, item.intent_id, error=failure.text, seconds=time.perf_counter() - t0,
@@ -341,6 +349,8 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
             seconds = time.perf_counter() - t0
             record = alignment_record(scores, cuts, metrics, seconds)
             record.update({"intent": spec.id, "intent_text": intent.text, "relevant": relevant.to_dict()})
+            if queried is not None:
+                record["queries"] = queried
             out = ItemOutcome(item.kernel, item.intent_id, record=record, seconds=seconds,
                               line=_done_line(item.kernel, spec.id, record, seconds))
     out = attrs.evolve(out, lm=_lm_delta(comp, before))
@@ -361,11 +371,29 @@ def _pooled(suite: Suite, records: Sequence[Mapping[str, Any]], thresholds: Sequ
     return pooled_alignment_metrics(rows, thresholds, REPORT_SUBSETS)
 
 
+def _pooled_queries(suite: Suite, records: Sequence[Mapping[str, Any]]) -> dict:
+    """``{subset: metrics}`` after the queries, pooled over the intents as :func:`_pooled` pools the cuts."""
+    by_id = {s.id: s for s in suite.intents}
+    rows, th = [], None
+    for r in records:
+        q = r.get("queries")
+        if not q:
+            continue
+        spec, th = by_id[r["intent"]], q["threshold"]
+        decision = np.array([q["decision"][t.object] for t in spec.test])
+        rows.append((decision, [t.relevant for t in spec.test], subset_masks(spec), {th: q["cut"]}, q["metrics"]))
+    return pooled_alignment_metrics(rows, [th], REPORT_SUBSETS)[th] if rows else {}
+
+
 def _intent_entry(record: Mapping[str, Any]) -> dict[str, Any]:
-    return {"intent": record["intent"], "intent_text": record["intent_text"], "seconds": record["seconds"],
-            "relevant": record["relevant"], "details": record["details"], "fallbacks": record["fallbacks"],
-            "thresholds": {k: {"cut": v["cut"], "note": v["note"]} for k, v in record["thresholds"].items()},
-            "metrics": {k: v["metrics"] for k, v in record["thresholds"].items()}, "objects": record["objects"]}
+    out = {"intent": record["intent"], "intent_text": record["intent_text"], "seconds": record["seconds"],
+           "relevant": record["relevant"], "details": record["details"], "fallbacks": record["fallbacks"],
+           "thresholds": {k: {"cut": v["cut"], "note": v["note"]} for k, v in record["thresholds"].items()},
+           "metrics": {k: v["metrics"] for k, v in record["thresholds"].items()}, "objects": record["objects"],
+           "scores": record["scores"]}
+    if "queries" in record:
+        out["queries"] = record["queries"]
+    return out
 
 
 class _Table:
@@ -388,9 +416,12 @@ class _Table:
             self.checkpoint(self.out)
 
     def _partial(self, kernel: str) -> dict:
-        return {"kernel": kernel, "errors": dict(self.errors), "overall": _pooled(self.suite, self.records,
-                                                                                  self.thresholds),
-                "intents": {r["intent"]: _intent_entry(r) for r in self.records}}
+        out = {"kernel": kernel, "errors": dict(self.errors), "overall": _pooled(self.suite, self.records,
+                                                                                 self.thresholds),
+               "intents": {r["intent"]: _intent_entry(r) for r in self.records}}
+        if any("queries" in r for r in self.records):
+            out["queries"] = _pooled_queries(self.suite, self.records)
+        return out
 
     def build_failed(self, kernel: str, error: str, shown: bool = False) -> None:
         self.out["kernels"][kernel] = {"kernel": kernel, "errors": {"*": error}, "overall": {}, "intents": {}}
@@ -428,7 +459,8 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                        progress: Callable[[str], None] | None = None,
                        checkpoint: Callable[[dict[str, Any]], None] | None = None,
                        executor: Executor | str | None = None, echo: bool = False,
-                       stages: str | Path | None = None, config: StudyConfig | None = None) -> dict[str, Any]:
+                       stages: str | Path | None = None, config: StudyConfig | None = None,
+                       queries: int = 0, query_policy: str = "uncertainty", abstain: float = 0.0) -> dict[str, Any]:
     """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
 
     The work is one :class:`AlignItem` per (kernel, intent) on ``executor`` (None: ``serial``); with
@@ -438,6 +470,8 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     keeps what it computed); a pool calls them when its ``map`` returns (with ``echo``, workers print
     each line to stderr as soon as it is done). ``stages``: a directory for the stage cache of the
     inferred intents. ``config``: the study sizes for the demonstrations (default :class:`StudyConfig`).
+    ``queries`` / ``query_policy`` / ``abstain``: questions per kernel and intent answered from the suite's
+    labels, and the abstention band (:func:`~gift.study.chain.query_stage`); results under ``queries``.
     """
     started, t0 = time.time(), time.perf_counter()
     if isinstance(suite, str):
@@ -454,10 +488,18 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     base = config or StudyConfig()
     cfg = attrs.evolve(base, suite=suite.path or suite.name, robot=robot, lm=lm, kernels=tuple(kernels),
                        intents=tuple(intents or ()), intent_source=intent_source, thresholds=tuple(thresholds),
-                       rq1=False, rq3=False, sanity_reps=0)
+                       rq1=False, rq3=False, sanity_reps=0, queries=queries, query_policy=query_policy,
+                       abstain=abstain)
+    if queries or abstain:
+        check = check_spec("query_policy", query_policy)
+        if check is not None:
+            raise GiftError(check)
     specs = [s for s in suite.intents if intents is None or s.id in intents]
     out: dict[str, Any] = {"suite": suite.name, "suite_path": suite.path, "intent_source": intent_source,
                            "thresholds": list(thresholds), "lm": lm, "kernels": {}}
+    if queries or abstain:
+        out["queries"] = {"n": queries, "policy": query_policy, "abstain": abstain,
+                          "threshold": query_threshold(cfg)}
     out_dir = None if stages is None else str(Path(stages).resolve())
     with using_executor(executor) as ex:
         table = _Table(out, suite, thresholds, progress, checkpoint, live=ex.in_process)

@@ -41,6 +41,29 @@ def check_kernels(specs: tuple[str, ...]) -> tuple[str, ...]:
     return specs
 
 
+def add_query_arguments(p: argparse.ArgumentParser) -> None:
+    """``--queries N --policy NAME --abstain BAND``: questions the simulated human (the suite's labels) answers."""
+    p.add_argument("--queries", type=int, default=0, metavar="N",
+                   help="per intent and kernel, ask the simulated human (the suite's labels) N questions "
+                        "'is this object part of the goal?' and re-score (default 0); adds a row per kernel")
+    p.add_argument("--policy", default="uncertainty", metavar="NAME",
+                   help="query policy choosing the questions: uncertainty (default), disagreement, error-bound, "
+                        "random, or another registered one (gift plugins)")
+    p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
+                   help="flag instead of decide the objects whose decision score is within BAND of the cut; "
+                        "their features are dropped like a distractor's (default 0: never)")
+
+
+def _check_queries(args: argparse.Namespace) -> None:
+    if args.queries < 0:
+        raise GiftError(f"--queries must be >= 0, got {args.queries}")
+    if not 0.0 <= args.abstain <= 1.0:
+        raise GiftError(f"--abstain must be in [0, 1] (a distance to the cut), got {args.abstain}")
+    policies = _names("query_policy")
+    if args.policy not in policies:
+        raise GiftError(f"unknown query policy {args.policy!r}; registered: {', '.join(policies)}")
+
+
 def _configure_reproduce(p: argparse.ArgumentParser) -> None:
     from gift.study.chain import ALL_KERNELS
 
@@ -62,6 +85,7 @@ def _configure_reproduce(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-rq3", action="store_true")
     p.add_argument("--demonstrations", default=None, metavar="DIR",
                    help="saved training sets (<intent>.npz/.json) to use instead of simulating the human")
+    add_query_arguments(p)
     p.add_argument("--out", default="out/reproduce", help="output directory")
     add_executor_argument(p)  # one item per intent; the executor does not change the results
 
@@ -82,12 +106,14 @@ def _config_from_args(args: argparse.Namespace):
     from gift.study.chain import StudyConfig
 
     _check_choices(args)
+    _check_queries(args)
     return StudyConfig(suite=args.suite, robot=args.robot, pairs=args.pairs, seeds=args.seeds, samples=args.samples,
                        lm=args.lm, kernels=check_kernels(_split(args.kernels)), reward=args.reward,
                        intents=_split(args.intents), intent_source=args.intent_source,
                        thresholds=_split(args.thresholds), train_scenes=args.train_scenes,
                        sanity_reps=args.sanity_reps, trajectories_per_generator=args.trajectories,
-                       rq3=not args.no_rq3, demonstrations=args.demonstrations)
+                       rq3=not args.no_rq3, demonstrations=args.demonstrations, queries=args.queries,
+                       query_policy=args.policy, abstain=args.abstain)
 
 
 def run_study_command(cfg, out: Path, command: str, executor=None) -> dict:
@@ -204,6 +230,7 @@ def _configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the full result as JSON")
     p.add_argument("--out", default=None, metavar="FILE", help="also write the full JSON result to FILE")
     p.add_argument("--detailed", action="store_true", help="also print every metric per subset")
+    add_query_arguments(p)
     add_executor_argument(p)  # one item per (kernel, intent); serial checkpoints --out after every item
 
 
@@ -217,6 +244,7 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
         raise GiftError("--kernels is empty")
     thresholds = [t.strip() for t in args.threshold.split(",") if t.strip()]
     intents = [i.strip() for i in args.intents.split(",")] if args.intents else None
+    _check_queries(args)
 
     def write(result: dict) -> None:  # serial: after every kernel x intent, so an interrupted run keeps its numbers
         write_json(Path(args.out), result)
@@ -226,7 +254,8 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
         result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
                                     lm=args.lm, intents=intents, robot=args.robot, progress=log.info,
                                     checkpoint=write if args.out else None, executor=executor,
-                                    echo=not executor.in_process and executor.live_stderr, stages=stages)
+                                    echo=not executor.in_process and executor.live_stderr, stages=stages,
+                                    queries=args.queries, query_policy=args.policy, abstain=args.abstain)
     if args.json:
         from gift.core.serialization import to_jsonable
 

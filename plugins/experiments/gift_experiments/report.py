@@ -457,6 +457,16 @@ def alignment_report(result: Mapping[str, Any], *, per_intent: bool = True, deta
             fpfn = " | ".join(f"{o[s]['fp']}/{o[s]['fn']}" if s in o else "-" for s in subs)
             lines.append(f"| {kname} | {thr} | {u['precision']:.2f} | {u['recall']:.2f} | **{u['f1']:.2f}** | "
                          f"{_f(u['auc_mean_intent'])} | {u['fp']} | {u['fn']} | {f1s} | {fpfn} |")
+        q, u = result.get("queries"), (k.get("queries") or {}).get("all")
+        if q and u:  # the same threshold after the simulated human's answers (gift.core.queries)
+            o = k["queries"]
+            label = (f"{q['threshold']} +{q['n']}q {q['policy']}" + (f" abstain {q['abstain']:g} "
+                     f"({sum(r['queries']['n_abstained'] for r in k['intents'].values())} flagged)"
+                                                                   if q["abstain"] else ""))
+            f1s = " | ".join(f"{o[s]['f1']:.2f}" if s in o else "-" for s in subs)
+            fpfn = " | ".join(f"{o[s]['fp']}/{o[s]['fn']}" if s in o else "-" for s in subs)
+            lines.append(f"| {kname} | {label} | {u['precision']:.2f} | {u['recall']:.2f} | **{u['f1']:.2f}** | "
+                         f"{_f(u['auc_mean_intent'])} | {u['fp']} | {u['fn']} | {f1s} | {fpfn} |")
     if detailed:
         lines += ["", "| kernel | threshold | subset | n | precision | recall | F1 | AUC (mean/intent) | FP | FN |",
                   "|---|---|---|---|---|---|---|---|---|---|"]

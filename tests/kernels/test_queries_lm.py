@@ -1,0 +1,110 @@
+"""Each query policy on the real `gift-prob` kernel (embedded LM on llama.cpp, reduced: one intent, six test
+objects), with answers simulated from the suite's labels. The kernel runs once; every session re-scores."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gift
+from gift.core.alignment import score_alignment
+from gift.core.data import DISTRACTOR, Intent
+from gift.core.metrics import binary_metrics
+from gift.core.queries import (QueryProblem, align_with_queries, answered_cut, ask, asking, belief, labels_answerer,
+                               resolve)
+from gift.core.suite import load_suite
+
+pytestmark = [pytest.mark.slow, pytest.mark.lm]
+
+SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
+TEST = ["colored pencils", "crayons", "toothbrush", "apple", "paint roller", "hairbrush"]
+
+
+@pytest.fixture(scope="module")
+def scene():
+    gift_llm = pytest.importorskip("gift_llm")
+    lm = gift_llm.get_default_lm()
+    suite = load_suite(SUITE)
+    spec = suite.intent("art_supplies")
+    kernel = gift.get_kernel("gift-prob", lm=lm)
+    test, train = suite.specs(TEST), suite.specs(spec.train_objects)
+    intent = Intent(text=spec.text, source="ground-truth")
+    scores = score_alignment(kernel, test, train, intent, relevant_train=spec.relevant_train)
+    labels = {t.object: t.relevant for t in spec.test if t.object in TEST}
+    return kernel, test, train, intent, spec, scores, labels
+
+
+def f1(state, labels):
+    return binary_metrics(state.predicted, [labels[t] for t in state.test]).f1
+
+
+def test_the_real_kernel_reports_the_terms_the_disagreement_policy_reads(scene):
+    *_, scores, labels = scene
+    terms = scores.details["terms"]
+    assert set(terms) == {"lm", "language"}
+    for view in terms.values():
+        assert len(view["test"]) == len(TEST) and len(view["train"]) == 4
+    st = resolve(QueryProblem.of(scores))
+    views = st.view_beliefs()
+    assert set(views) == {"lm", "language"} and all(v.shape == (len(TEST),) for v in views.values())
+    # the LM's log-odds order the test objects the same way its view does
+    lm = np.asarray(terms["lm"]["test"])
+    assert np.array_equal(np.argsort(lm, kind="stable"), np.argsort(views["lm"], kind="stable")) or \
+        len(set(np.round(lm, 9))) < len(lm)
+
+
+@pytest.mark.parametrize("policy", ["uncertainty", "disagreement", "error-bound", "random"])
+def test_each_policy_asks_about_the_real_scores_and_the_answers_re_score_the_scene(scene, policy):
+    *_, scores, labels = scene
+    problem = QueryProblem.of(scores)
+    before = resolve(problem)
+    states = list(asking(problem, policy, labels_answerer(labels), 2, seed=1))
+    after = states[-1]
+    asked = [a.object for a in after.answers]
+    assert len(asked) == 2 == len(set(asked))
+    # what the policy asked first, recomputed from the kernel's numbers by its own definition
+    d, cut = scores.decision, before.cut
+    if policy == "uncertainty":
+        assert asked[0] == TEST[int(np.argmin(np.round(np.abs(d - cut), 12)))]
+    elif policy == "disagreement":
+        views = []
+        for view in scores.details["terms"].values():  # each term on the relevance scale: sigmoid(z-score)
+            raw = np.array(view["test"] + view["train"])
+            r = 1 / (1 + np.exp(-(raw - raw.mean()) / raw.std()))
+            v = scores.with_relevance(r[: len(TEST)], r[len(TEST):])
+            views.append(belief(v.decision, answered_cut(v, "train-calibrated", ())[0]))
+        spread = np.ptp(np.stack(views), axis=0)
+        assert spread[TEST.index(asked[0])] == pytest.approx(spread.max())
+    elif policy == "error-bound":
+        gain = gift.get_query_policy("error-bound").priority(before, np.random.default_rng(0))
+        assert gain[TEST.index(asked[0])] == pytest.approx(gain.max())
+    # answered objects are fixed to the human's answer; the cut is the train-calibrated cut with them
+    for a in after.answers:
+        i = TEST.index(a.object)
+        assert a.relevant == labels[a.object] and after.predicted[i] == labels[a.object]
+        assert (after.alignment.target(a.object) in ("paintbrush", "sketchbook")) == labels[a.object]
+        assert after.alignment.target(a.object) == DISTRACTOR or after.alignment.scores[a.object] == 1.0
+    assert after.cut == pytest.approx(answered_cut(scores, "train-calibrated", after.answers)[0])
+    # the state after each answer is the scene re-scored, without the kernel (no new LM question)
+    assert [len(s.answers) for s in states] == [0, 1, 2]
+    everything = ask(problem, policy, labels_answerer(labels), len(TEST), seed=1)
+    assert f1(everything, labels) == 1.0  # every object answered: every object right
+
+
+def test_a_python_callback_on_the_real_kernel_without_new_lm_questions(scene):
+    kernel, test, train, intent, spec, scores, labels = scene
+    calls_before = kernel.calls
+    asked = []
+
+    def human(obj):
+        asked.append(obj)
+        return labels[obj]
+
+    st = align_with_queries(kernel, test, train, intent, relevant_train=spec.relevant_train, answer=human, n=2,
+                            abstain=0.02)
+    assert kernel.calls == calls_before  # the kernel's answers are remembered: no LM call for the session
+    assert len(asked) == 2 and [a.object for a in st.answers] == asked
+    assert f1(st, labels) >= f1(resolve(QueryProblem.of(scores, abstain=0.02)), labels)
+    assert all(abs(scores.decision[TEST.index(t)] - st.cut) < 0.02 for t in st.abstained)
