@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gift_sim_drake.plant import SceneModel, drake_ik
-from gift_sim_drake.robots import ROBOTS
+from gift_sim_drake.robots import ROBOTS, arm_kinematics
 
 pytestmark = pytest.mark.drake
 
@@ -15,13 +15,13 @@ pytestmark = pytest.mark.drake
 def test_urdf_is_self_contained(robot):
     text = ROBOTS[robot].urdf_path.read_text()
     assert "package://" not in text and "<mesh" not in text
-    assert ROBOTS[robot].kinematics.dof == 7
+    assert arm_kinematics(ROBOTS[robot]).dof == 7
 
 
 @pytest.mark.parametrize("robot", sorted(ROBOTS))
 def test_numpy_fk_matches_drake_plant(robot, objects):
     spec = ROBOTS[robot]
-    kin = spec.kinematics
+    kin = arm_kinematics(spec)
     model = SceneModel(spec, "pack_backpack", objects, {"backpack": (0.4, 0.4, 0.09)})
     lo, hi = model.joint_limits()
     np.testing.assert_allclose(lo, kin.lower)
@@ -39,10 +39,11 @@ def test_local_ik_refines_drake_ik(robot):
     spec = ROBOTS[robot]
     target = np.array([0.45, 0.1, 0.12])
     q0 = drake_ik(spec).solve(target, spec.rest)
-    pos, rot = spec.kinematics.fk(q0)
+    kin = arm_kinematics(spec)
+    pos, rot = kin.fk(q0)
     assert np.abs(pos - target).max() < 2e-4 and rot[2, 2] < -0.999
     moved = target + [0.02, -0.015, 0.01]
-    q, err = spec.kinematics.solve_pointing_down(q0[None], moved[None])
+    q, err = kin.solve_pointing_down(q0[None], moved[None])
     assert err[0] < 1e-5
-    assert np.abs(spec.kinematics.fk(q[0])[0] - moved).max() < 1e-5
-    assert (q >= spec.kinematics.lower).all() and (q <= spec.kinematics.upper).all()
+    assert np.abs(kin.fk(q[0])[0] - moved).max() < 1e-5
+    assert (q >= kin.lower).all() and (q <= kin.upper).all()
