@@ -118,6 +118,7 @@ class RobotSpec:
             path = Path(str(resources.files(self.package).joinpath(self.urdf)))
         if not path.is_file():
             where = f" in package {self.package!r}" if self.package else ""
-            raise ValidationError(f"robot {self.name!r}: URDF file {self.urdf!r}{where} not found (looked at {path}); "
-                                  f"ship it as package data")
+            hint = "; ship it as package data" if self.package else ""
+            raise ValidationError(f"robot {self.name!r}: URDF file {self.urdf!r}{where} not found (looked at "
+                                  f"{path}){hint}")
         return path

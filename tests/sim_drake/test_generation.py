@@ -1,4 +1,4 @@
-"""Trajectory generation on the real plant: both arms, all four families."""
+"""Trajectory generation on the real plant: the built-in arms and the example UR5e, all four families."""
 
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ def test_shapes_and_joint_limits_on_the_plant(generated, simulators, objects, ro
     model = SceneModel(simulators[robot].robot, family, objects, scene.landmarks)
     lo, hi = model.joint_limits()
     for gen, b in batches.items():
-        assert b.joint_positions.shape == (12, N_STEPS, 7)
+        assert b.joint_positions.shape == (12, N_STEPS, simulators[robot].dof)
         assert b.object_positions.shape == (12, N_STEPS, 4, 3)
         assert (b.joint_positions >= lo).all() and (b.joint_positions <= hi).all(), gen
         assert b.ee_positions[..., 2].min() > 0.0  # never through the table

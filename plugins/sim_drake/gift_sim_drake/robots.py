@@ -56,8 +56,9 @@ def arm_kinematics(spec: RobotSpec) -> ArmKinematics:
 
 @lru_cache(maxsize=None)
 def _kinematics(spec: RobotSpec) -> ArmKinematics:
+    path = spec.urdf_path  # a missing file: its own ValidationError
     try:
-        return ArmKinematics.from_urdf(spec.urdf_path, spec.base_link, spec.ee_link, spec.mount)
+        return ArmKinematics.from_urdf(path, spec.base_link, spec.ee_link, spec.mount)
     except GiftError as e:
         raise GiftError(f"robot {spec.name!r}: {e}") from None
 
