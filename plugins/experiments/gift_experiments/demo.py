@@ -16,13 +16,14 @@ DEMO_KERNELS = ("vision", "language", "gift-prob")
 
 
 def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("out/demo"),
-         progress: bool = True, kernels: tuple[str, ...] = DEMO_KERNELS) -> int:
-    cfg = ReproduceConfig(intents=(intent,), lm=lm, kernels=tuple(kernels), **DEMO)
+         progress: bool = True, kernels: tuple[str, ...] = DEMO_KERNELS, robot: str = DEMO["robot"]) -> int:
+    cfg = ReproduceConfig(intents=(intent,), lm=lm, kernels=tuple(kernels), **{**DEMO, "robot": robot})
     t0 = time.perf_counter()
     results = run(cfg, out, Progress(progress), log=lambda m: None)
     elapsed = time.perf_counter() - t0
     results["timing"]["total"] = elapsed
-    report = write_report(results, out, command=f"gift demo --intent {intent}")
+    command = f"gift demo --intent {intent}" + (f" --robot {robot}" if robot != DEMO["robot"] else "")
+    report = write_report(results, out, command=command)
     intent_text = results["intents"][intent]["text"]
     print(f"intent {intent!r}: inferred -> {intent_text!r}")
     print(f"{'kernel':<16} {'win rate':>9} {'F1':>6}")

@@ -10,19 +10,44 @@ from pathlib import Path
 
 from gift.core.executor import add_executor_argument, executor_from_args
 from gift.plugins.hookspecs import hookimpl
+from gift.plugins.manager import get_manager
+
+
+def robot_choices() -> list[str]:
+    """Registered robots that some simulator plugin builds a simulator for."""
+    manager = get_manager()
+    return [r for r in manager.names("robot") if manager.simulators_for_robot(r)]
+
+
+def kernel_list(text: str) -> tuple[str, ...]:
+    """``--kernels``: comma-separated names, each a registered kernel (else a clear argparse error)."""
+    names = tuple(k.strip() for k in text.split(",") if k.strip())
+    known = get_manager().names("kernel")
+    unknown = [k for k in names if k not in known]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"unknown kernel(s) {', '.join(map(repr, unknown))}; registered kernels: "
+                                         f"{', '.join(known)}" if unknown else "give at least one kernel")
+    return names
+
+
+def _add_robot_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", default="jaco", choices=robot_choices(),
+                   help="a registered robot (gift plugins lists them; default: %(default)s)")
 
 
 def _configure_reproduce(p: argparse.ArgumentParser) -> None:
     from gift_experiments.reproduce import ALL_KERNELS
 
     p.add_argument("--suite", default="gift-paper", help="registered suite name or suite file")
-    p.add_argument("--robot", default="jaco", choices=["jaco", "franka"])
+    _add_robot_argument(p)
     p.add_argument("--pairs", type=int, default=250, help="trajectory pairs per test scene")
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--samples", type=int, default=10, help="LM samples per alignment (gift, lm-no-intent)")
     p.add_argument("--lm", default=None, help="LM to use (default: the embedded model)")
-    p.add_argument("--kernels", default=",".join(ALL_KERNELS), help="comma-separated kernel names")
-    p.add_argument("--reward", default="maxent-linear", choices=["maxent-linear", "maxent-neural"])
+    p.add_argument("--kernels", default=",".join(ALL_KERNELS), type=kernel_list,
+                   help="comma-separated registered kernel names")
+    p.add_argument("--reward", default="maxent-linear", choices=get_manager().names("reward_model"),
+                   help="a registered reward model (default: %(default)s)")
     p.add_argument("--intents", default="", help="comma-separated intent ids (default: all)")
     p.add_argument("--intent-source", default="inferred", choices=["inferred", "ground-truth"])
     p.add_argument("--thresholds", default="train-calibrated,non-oracle,oracle")
@@ -40,7 +65,7 @@ def _config_from_args(args: argparse.Namespace):
 
     split = lambda s: tuple(x.strip() for x in s.split(",") if x.strip())  # noqa: E731
     return ReproduceConfig(suite=args.suite, robot=args.robot, pairs=args.pairs, seeds=args.seeds,
-                           samples=args.samples, lm=args.lm, kernels=split(args.kernels), reward=args.reward,
+                           samples=args.samples, lm=args.lm, kernels=args.kernels, reward=args.reward,
                            intents=split(args.intents), intent_source=args.intent_source,
                            thresholds=split(args.thresholds), train_scenes=args.train_scenes,
                            sanity_reps=args.sanity_reps, trajectories_per_generator=args.trajectories,
@@ -70,8 +95,9 @@ def run_reproduce(args: argparse.Namespace) -> int:
 
 def _configure_demo(p: argparse.ArgumentParser) -> None:
     p.add_argument("--intent", default="art_supplies", help="intent id of the gift-paper suite")
+    _add_robot_argument(p)
     p.add_argument("--lm", default=None, help="LM to use (default: the embedded model)")
-    p.add_argument("--kernels", default="vision,language,gift-prob",
+    p.add_argument("--kernels", default="vision,language,gift-prob", type=kernel_list,
                    help="comma-separated kernels (add gift,lm-no-intent for the binary Call-3 kernels: slow on CPU)")
     p.add_argument("--out", default="out/demo")
     p.add_argument("--quiet", action="store_true")
@@ -80,8 +106,8 @@ def _configure_demo(p: argparse.ArgumentParser) -> None:
 def run_demo(args: argparse.Namespace) -> int:
     from gift_experiments.demo import demo
 
-    kernels = tuple(k.strip() for k in args.kernels.split(",") if k.strip())
-    return demo(intent=args.intent, lm=args.lm, out=Path(args.out), progress=not args.quiet, kernels=kernels)
+    return demo(intent=args.intent, lm=args.lm, out=Path(args.out), progress=not args.quiet, kernels=args.kernels,
+                robot=args.robot)
 
 
 @hookimpl

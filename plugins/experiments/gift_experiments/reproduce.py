@@ -124,7 +124,7 @@ class Components:
 
     def simulator(self, robot: str):
         if robot not in self._sims:
-            self._sims[robot] = gift.get_simulator(f"drake-{robot}")
+            self._sims[robot] = gift.get_simulator(gift.robot_simulator(robot))
         return self._sims[robot]
 
     @property
