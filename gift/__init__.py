@@ -4,6 +4,7 @@ Lookup of registered components::
 
     import gift
     kernel = gift.get_kernel("language")
+    lm = gift.resolve_lm()            # the embedded LM (or $GIFT_LM), cached
     gift.list_components()            # {"kernel": [...], "simulator": [...], ...}
     gift.get_robot("franka")          # a RobotSpec; gift.robot_simulator("franka") -> "drake-franka"
 """
@@ -85,8 +86,25 @@ def get_reward_model(name: str, **options: Any):
     return get_component("reward_model", name, **options)
 
 
-def get_lm(name: str, **options: Any):
-    return get_component("lm_backend", name, **options)
+def resolve_lm(spec: Any = None, **options: Any):
+    """The one way to get an LM: ``spec`` is None (``$GIFT_LM`` or the embedded default), a registered
+    backend name, ``"backend:model"`` (``"litellm:openai/gpt-4o"``), or an LM backend instance (returned
+    as is). Names are resolved by the plugin implementing ``gift_resolve_lm`` (``gift-llm``: cached,
+    optionally recorded; ``cache=False`` for a bare backend)."""
+    from gift.core.errors import LMError
+    from gift.core.interfaces import LMBackend
+
+    if isinstance(spec, LMBackend) or (spec is not None and not isinstance(spec, str) and hasattr(spec, "complete")):
+        if options:
+            raise LMError(f"resolve_lm: options {sorted(options)} cannot apply to an LM instance")
+        return spec
+    if spec is not None and not isinstance(spec, str):
+        raise LMError(f"resolve_lm: expected a backend name, a 'backend:model' string or an LM backend, got "
+                      f"{type(spec).__name__}")
+    lm = get_manager().pm.hook.gift_resolve_lm(spec=spec, options=dict(options))
+    if lm is None:
+        raise LMError("no plugin resolves LM names: install gift-llm (pip install -e plugins/llm)")
+    return lm
 
 
 def list_components(kind: str | None = None) -> dict[str, list[dict[str, str]]]:
@@ -103,5 +121,5 @@ __all__ = [
     "TrajectoryBatch", "Usage", "RobotSpec", "GiftError", "LMAnswerError", "LMError", "PluginError", "SuiteError",
     "UnknownComponentError", "GiftPipeline", "Suite", "load_suite", "hookimpl", "get_manager", "get_component",
     "get_simulator", "get_robot", "robot_simulator", "get_task", "get_kernel", "get_intent_estimator",
-    "get_alignment_operator", "get_reward_model", "get_lm", "list_components",
+    "get_alignment_operator", "get_reward_model", "resolve_lm", "list_components",
 ]

@@ -1,33 +1,66 @@
-"""Regenerate the gift-paper tables in docs/suites.md from the suite file (run after editing the suite):
+"""Regenerate the suite tables in docs/suites.md from the suite files (run after editing a suite):
 
     .venv/bin/python scripts/suite_doc_tables.py
+
+Each generated block sits between ``<!-- tables:NAME -->`` and ``<!-- /tables:NAME -->`` markers.
 """
 
 import re
+from pathlib import Path
 
 import gift
-s = gift.load_suite('gift-paper')
-omega = {"water_sensitive":"ω1","paper_based":"ω2","art_supplies":"ω3a","reading_material":"ω3b","valuables":"ω4a","electronics":"ω4b"}
-summ = ["| intent | paper | task | train (relevant) | test (relevant) | S_R | S_lang | S_vis | S_unk |",
-        "|---|---|---|---|---|---|---|---|---|"]
-for i in s.intents:
-    sz = [len(i.subset(c)) for c in ("R","lang","vis","unk")]
-    summ.append(f"| `{i.id}` | {omega[i.id]} | `{i.task}` | {len(i.train_objects)} ({len(i.relevant_train)}) | {len(i.test)} ({len(i.relevant_test)}) | " + " | ".join(str(x) if x else "–" for x in sz) + " |")
-tab = []
-for i in s.intents:
-    tab.append(f"#### `{i.id}` — {omega[i.id]}: *{i.text}* (task `{i.task}`)\n")
-    rel = ", ".join(i.relevant_train); irr = ", ".join(o for o in i.train_objects if o not in i.relevant_train)
-    tab.append(f"Training objects: **relevant** {rel}; **irrelevant** {irr}.\n")
-    tab.append("| test object | relevant | subsets |\n|---|---|---|")
-    for t in i.test:
-        sub = ", ".join("S_"+c for c in t.confounds) if t.confounds else "S_R"
-        tab.append(f"| {t.object} | {'yes' if t.relevant else 'no'} | {sub} |")
-    tab.append("")
-p = __import__('pathlib').Path(__file__).resolve().parents[1] / 'docs' / 'suites.md'
-d=open(p).read()
-d=re.sub(r"\| intent \| paper \|.*?\n\n", "\n".join(summ)+"\n\n", d, count=1, flags=re.S)
-head, rest = d.split("#### `water_sensitive`",1)
-_, tail = rest.split("## Writing your own suite",1)
-d = head + "\n".join(tab) + "\n## Writing your own suite" + tail
-d = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(s.objects)} objects", d)
-open(p,'w').write(d)
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "suites.md"
+PAPER_OMEGA = {"water_sensitive": "ω1", "paper_based": "ω2", "art_supplies": "ω3a", "reading_material": "ω3b",
+               "valuables": "ω4a", "electronics": "ω4b"}
+DEV_LABEL = {"cloth_items": "d1a", "breakables": "d1b", "leather_goods": "d2a", "wooden_items": "d2b",
+             "toiletries": "d3a", "sewing_supplies": "d3b", "baking_tools": "d4a", "gardening_supplies": "d4b"}
+
+
+def summary(suite, label: dict[str, str], column: str) -> str:
+    rows = [f"| intent | {column} | task | train (relevant) | test (relevant) | S_R | S_lang | S_vis | S_unk |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for i in suite.intents:
+        sizes = [len(i.subset(c)) for c in ("R", "lang", "vis", "unk")]
+        rows.append(f"| `{i.id}` | {label[i.id]} | `{i.task}` | {len(i.train_objects)} ({len(i.relevant_train)}) | "
+                    f"{len(i.test)} ({len(i.relevant_test)}) | " + " | ".join(str(x) if x else "–" for x in sizes)
+                    + " |")
+    return "\n".join(rows)
+
+
+def intent_tables(suite, label: dict[str, str]) -> str:
+    out = []
+    for i in suite.intents:
+        out.append(f"#### `{i.id}` — {label[i.id]}: *{i.text}* (task `{i.task}`)\n")
+        rel = ", ".join(i.relevant_train)
+        irr = ", ".join(o for o in i.train_objects if o not in i.relevant_train)
+        out.append(f"Training objects: **relevant** {rel}; **irrelevant** {irr}.\n")
+        out.append("| test object | relevant | subsets |\n|---|---|---|")
+        for t in i.test:
+            sub = ", ".join("S_" + c for c in t.confounds) if t.confounds else "S_R"
+            out.append(f"| {t.object} | {'yes' if t.relevant else 'no'} | {sub} |")
+        out.append("")
+    return "\n".join(out)
+
+
+def put(doc: str, name: str, body: str) -> str:
+    pattern = re.compile(rf"(<!-- tables:{re.escape(name)} -->\n).*?(<!-- /tables:{re.escape(name)} -->)", re.DOTALL)
+    if not pattern.search(doc):
+        raise SystemExit(f"docs/suites.md has no <!-- tables:{name} --> block")
+    return pattern.sub(lambda m: m.group(1) + body.rstrip("\n") + "\n" + m.group(2), doc, count=1)
+
+
+def main() -> None:
+    doc = DOC.read_text(encoding="utf-8")
+    paper, dev = gift.load_suite("gift-paper"), gift.load_suite("gift-dev")
+    doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
+    doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
+    doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
+    doc = put(doc, "gift-dev:intents", intent_tables(dev, DEV_LABEL))
+    doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
+    doc = re.sub(r"its catalog holds \d+ objects", f"its catalog holds {len(dev.objects)} objects", doc)
+    DOC.write_text(doc, encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()

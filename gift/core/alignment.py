@@ -1,5 +1,51 @@
-"""f_ω(ξ'): applying an object alignment to trajectories' features.
+"""Alignment: f_ω on objects (the argmax-threshold rule and its thresholds) and on trajectories' features.
 
+This module is the one place where the paper's alignment lives:
+
+- :func:`score_alignment` runs a kernel once over a test scene and returns :class:`AlignmentScores`
+  (K, a decision score per test object, the matched training object, and what the training-set
+  thresholds need); :meth:`AlignmentScores.threshold` picks a cut, :meth:`AlignmentScores.alignment`
+  turns it into an :class:`~gift.core.data.Alignment` (test object -> training object or DISTRACTOR).
+- :class:`ArgmaxThresholdAlignment` is the registered ``argmax-threshold`` operator built on it.
+- :func:`align_features` applies an alignment to a batch of trajectories (f_ω(ξ')), a remapping of
+  feature columns; :func:`trajectory_error_bounds` is the paper's bound per aligned trajectory.
+
+The alignment rule (every kernel follows it)
+--------------------------------------------
+Let ``rel`` be the training objects the intent makes relevant (``relevant_train``; empty = unknown).
+
+- A :class:`~gift.core.interfaces.SimilarityKernel` (vision, language, lm-no-intent, gift) gives
+  ``K = similarity(test, train, intent)`` ``[n_test, n_train]``: the paper's rule. The target of test
+  object i is ``j* = argmax_j K[i, j]`` over *all* training objects (ties go to a relevant one); i is
+  aligned to ``j*`` when ``K[i, j*] >= threshold``, else it is a DISTRACTOR. It is predicted *relevant*
+  when aligned to a relevant training object. Its **decision score** is ``K[i, j*]`` when ``j*`` is
+  relevant (or ``rel`` is empty), and ``max_{j in rel} K[i, j] - 1`` (in [-1, 0], below every cut) when
+  the best match is an irrelevant training object: the threshold can never make it relevant, and such
+  objects still rank among themselves (AUC) by their similarity to the relevant ones.
+- A :class:`~gift.core.interfaces.RelevanceKernel` (``gift-prob``) scores every object once per scene
+  (:meth:`~gift.core.interfaces.RelevanceKernel.score`): a relevance ``r_i`` in [0, 1] per test object
+  (the decision score) and the same score for each training object left out of the others. Its K puts
+  ``r_i`` in the relevant columns; the target is the relevant training object with the highest K
+  (the first one, since they tie) when ``r_i`` reaches the threshold, else DISTRACTOR.
+
+Predicted relevant = aligned to a relevant training object = ``decision score >= threshold``.
+
+Thresholds (``threshold=``)
+---------------------------
+- a float in [0, 1]: fixed;
+- ``"non-oracle"`` (the paper's): the mean of K over pairs of distinct training objects (for a
+  relevance kernel, K of the training objects from their leave-one-out relevance);
+- ``"train-calibrated"``: leave-one-out over the training objects. Each training object t is scored as
+  if it were a test object against the *other* training objects (``rel`` minus t), relevant ones are
+  positives and the others negatives, and the cut is the midpoint that best separates them (highest
+  balanced accuracy; ties: the widest gap). No test label is used. Matrix kernels reuse
+  ``K(train, train)`` with the diagonal masked; relevance kernels return the scores from their one
+  pass. A relevant object with no relevant partner left is not a usable positive. With no positive or
+  no negative left it falls back to ``non-oracle`` and says so in the note.
+- ``"oracle"``: the cut that maximises F1 on the labelled test objects (``test_labels``): an upper bound.
+
+f_ω on trajectories
+-------------------
 Alignment renames the *semantic* components of every state (which object sits in which feature slot)
 and keeps continuous components (end-effector features) as they are. Since a feature of a test object
 ``x`` becomes the same feature of its training counterpart ``f_ω(x)``, aligning a batch is a remapping
@@ -8,13 +54,20 @@ of feature columns: no new simulation and no per-state loop.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from functools import lru_cache
+from typing import Any, ClassVar
 
 import attrs
 import numpy as np
 
-from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec
+from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec, Intent, ObjectSpec
+from gift.core.errors import GiftError
+from gift.core.interfaces import AlignmentOperator, RelevanceKernel, SimilarityKernel
+from gift.core.metrics import binary_metrics
+
+
+# ============================================================================= f_ω on features
 
 
 @attrs.frozen
@@ -86,3 +139,300 @@ def align_state(values: np.ndarray, test_specs: Sequence[FeatureSpec], alignment
     """f_ω(s') for a single state's features ``[F_test]`` -> ``[F_train]``."""
     plan = plan_alignment(test_specs, dict(alignment.mapping), train_specs)
     return plan.apply(np.asarray(values, dtype=float)[None, None])[0, 0]
+
+
+# ============================================================================= f_ω on objects
+
+THRESHOLDS = ("oracle", "non-oracle", "train-calibrated")
+
+#: Decision score of an object that can never be aligned (no relevant training object exists for it).
+NEVER = -1.0
+
+
+def _check_matrix(K: Any, n_test: int, n_train: int, kernel: SimilarityKernel, what: str) -> np.ndarray:
+    K = np.asarray(K, dtype=float)
+    name = getattr(kernel, "name", type(kernel).__name__)
+    if K.shape != (n_test, n_train):
+        raise GiftError(f"kernel {name!r} returned a {K.shape} matrix for {what}; expected [{n_test}, {n_train}]")
+    if K.size and (not np.all(np.isfinite(K)) or K.min() < -1e-9 or K.max() > 1 + 1e-9):
+        raise GiftError(f"kernel {name!r} returned values outside [0, 1] for {what} "
+                        f"(min {np.nanmin(K):.3g}, max {np.nanmax(K):.3g})")
+    return np.clip(K, 0.0, 1.0)
+
+
+def _check_vector(r: Any, n: int, kernel: SimilarityKernel, what: str) -> np.ndarray:
+    r = np.asarray(r, dtype=float).reshape(-1)
+    name = getattr(kernel, "name", type(kernel).__name__)
+    if r.shape != (n,) or (r.size and (not np.all(np.isfinite(r)) or r.min() < -1e-9 or r.max() > 1 + 1e-9)):
+        raise GiftError(f"kernel {name!r}: the relevance of {what} must be [{n}] values in [0, 1], got {r}")
+    return np.clip(r, 0.0, 1.0)
+
+
+def matrix_decision(K: np.ndarray, rel_mask: np.ndarray, valid: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's rule on a similarity matrix: ``(decision score [n], target column [n])``.
+
+    ``rel_mask`` ``[n_train]`` marks the relevant columns (all False = relevance unknown: every column
+    counts as relevant); ``valid`` ``[n, n_train]`` masks columns a row may not use (leave-one-out).
+    """
+    n, m = K.shape
+    valid = np.ones_like(K, dtype=bool) if valid is None else valid
+    rel = rel_mask if rel_mask.any() else np.ones(m, dtype=bool)
+    Kv = np.where(valid, K, -np.inf)
+    # argmax with ties going to a relevant column: a tiny bonus that cannot reorder distinct values
+    target = np.argmax(Kv + 1e-12 * rel[None, :], axis=1) if m else np.zeros(n, dtype=int)
+    best = Kv[np.arange(n), target] if m else np.full(n, -np.inf)
+    best_rel = np.where(valid & rel[None, :], K, -np.inf).max(axis=1) if m else np.full(n, -np.inf)
+    score = np.where(rel[target], best, best_rel - 1.0)
+    score = np.where(np.isfinite(score), score, NEVER)
+    return np.maximum(score, NEVER), target
+
+
+def best_separating_cut(positives: Sequence[float], negatives: Sequence[float]) -> float:
+    """The cut (``score >= cut`` positive) with the highest balanced accuracy; ties: the widest gap.
+
+    Candidates are midpoints between consecutive distinct scores and points just outside the range.
+    """
+    p = np.asarray(positives, dtype=float)
+    n = np.asarray(negatives, dtype=float)
+    if p.size == 0 or n.size == 0:
+        raise GiftError("best_separating_cut needs at least one positive and one negative score")
+    values = np.unique(np.concatenate([p, n]))
+    gaps = np.diff(values)
+    cands = np.concatenate([[values[0] - 1e-6], (values[:-1] + values[1:]) / 2, [values[-1] + 1e-6]])
+    widths = np.concatenate([[0.0], gaps, [0.0]])
+    bacc = np.array([((p >= c).mean() + (n < c).mean()) / 2 for c in cands])
+    order = np.lexsort((-widths, -bacc))  # primary: balanced accuracy, secondary: gap width
+    return float(cands[order[0]])
+
+
+def oracle_cut(scores: Sequence[float], labels: Sequence[bool]) -> float:
+    """The cut maximising F1 of ``score >= cut`` on the labels, among cuts in [0, 1] (NEVER stays out)."""
+    s = np.asarray(scores, dtype=float)
+    y = np.asarray(labels, dtype=bool)
+    cands = np.unique(np.concatenate([s[s >= 0.0], [1.0 + 1e-9]]))
+    f1 = [binary_metrics(s >= c, y).f1 for c in cands]
+    # among equally good cuts take the highest: the fewest aligned objects for the same F1
+    best = max(range(len(cands)), key=lambda k: (f1[k], cands[k]))
+    return float(cands[best])
+
+
+@attrs.frozen
+class AlignmentScores:
+    """Everything the kernel said about one test scene, before a threshold is chosen.
+
+    ``K`` ``[n_test, n_train]``; ``decision`` ``[n_test]`` (predicted relevant iff ``>= threshold``);
+    ``aligned`` ``[n_test]`` (mapped to ``target`` iff ``>= threshold``, else DISTRACTOR: ``K`` at the
+    target for matrix kernels, the relevance for relevance kernels); ``target`` ``[n_test]`` training
+    column of the match;
+    ``train_mean``: mean of K over distinct training pairs (None if not computed); ``loo_scores`` /
+    ``loo_labels`` ``[m]``: leave-one-out decision scores of the training objects and whether each is
+    relevant (None if not computed).
+    """
+
+    test: tuple[str, ...]
+    train: tuple[str, ...]
+    relevant_train: tuple[str, ...]
+    K: np.ndarray = attrs.field(eq=False)
+    decision: np.ndarray = attrs.field(eq=False)
+    target: np.ndarray = attrs.field(eq=False)
+    aligned: np.ndarray = attrs.field(eq=False)
+    kernel: str = ""
+    train_mean: float | None = None
+    loo_scores: np.ndarray | None = attrs.field(default=None, eq=False)
+    loo_labels: np.ndarray | None = attrs.field(default=None, eq=False)
+    #: the kernel's LM answers completed by default during this pass (see MappingKernel.fallbacks)
+    fallbacks: tuple[str, ...] = ()
+    #: JSON-able notes of a relevance kernel's pass (e.g. the category asked about, term weights)
+    details: Mapping[str, Any] = attrs.field(factory=dict, eq=False)
+
+    def threshold(self, strategy: str | float, test_labels: Mapping[str, bool] | None = None
+                  ) -> tuple[float, str]:
+        """``(cut, note)`` for a strategy (see the module docstring). ``note`` says how it was chosen."""
+        if isinstance(strategy, (int, float)) and not isinstance(strategy, bool):
+            if not 0.0 <= float(strategy) <= 1.0:
+                raise GiftError(f"a fixed alignment threshold must be in [0, 1], got {strategy}")
+            return float(strategy), "fixed"
+        if strategy == "oracle":
+            if test_labels is None:
+                raise GiftError("the oracle threshold needs test labels (test_labels={object: relevant}); "
+                                "it is an upper bound for evaluation, not for deployment")
+            missing = [t for t in self.test if t not in test_labels]
+            if missing:
+                raise GiftError(f"oracle threshold: no label for test objects {missing}")
+            return oracle_cut(self.decision, [bool(test_labels[t]) for t in self.test]), "oracle (test labels)"
+        if strategy == "non-oracle":
+            if self.train_mean is None:
+                raise GiftError("non-oracle threshold: K(train, train) was not computed; pass "
+                                "need=('non-oracle',) to score_alignment")
+            return self.train_mean, "mean K over training pairs"
+        if strategy == "train-calibrated":
+            if not self.relevant_train:
+                if self.train_mean is None:
+                    raise GiftError("the train-calibrated threshold needs the relevant training objects "
+                                    "(relevant_train / --relevant) to tell positives from negatives")
+                return self.train_mean, "fallback to non-oracle: no relevant training object is known"
+            if self.loo_scores is None:
+                raise GiftError("train-calibrated threshold: leave-one-out scores were not computed; pass "
+                                "need=('train-calibrated',) to score_alignment")
+            usable = self.loo_scores > NEVER
+            pos = self.loo_scores[usable & self.loo_labels]
+            neg = self.loo_scores[usable & ~self.loo_labels]
+            if pos.size == 0 or neg.size == 0:
+                if self.train_mean is None:
+                    raise GiftError("train-calibrated threshold: the training objects give no positive or no "
+                                    "negative leave-one-out score, and no K(train, train) mean to fall back on")
+                return self.train_mean, (f"fallback to non-oracle: leave-one-out gave {pos.size} positive and "
+                                         f"{neg.size} negative scores")
+            return float(np.clip(best_separating_cut(pos, neg), 0.0, 1.0)), \
+                f"leave-one-out over {pos.size} relevant / {neg.size} other training objects"
+        raise GiftError(f"unknown threshold {strategy!r}; use one of {THRESHOLDS} or a number in [0, 1]")
+
+    def alignment(self, cut: float) -> Alignment:
+        """The Alignment for a cut: aligned iff ``aligned >= cut``; scores = K at the matched object."""
+        mapping, scores = {}, {}
+        for i, name in enumerate(self.test):
+            k = float(self.K[i, self.target[i]]) if self.train else 0.0
+            mapping[name] = self.train[self.target[i]] if self.train and self.aligned[i] >= cut else DISTRACTOR
+            scores[name] = k
+        return Alignment(mapping=mapping, scores=scores, threshold=float(cut), kernel=self.kernel)
+
+    def predicted_relevant(self, cut: float) -> np.ndarray:
+        """``[n_test]`` bool: aligned to a relevant training object."""
+        return self.decision >= cut
+
+
+def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                    intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+                    need: Sequence[str] = THRESHOLDS) -> AlignmentScores:
+    """Run the kernel once over a test scene; everything every threshold in ``need`` requires.
+
+    A :class:`~gift.core.interfaces.RelevanceKernel` is asked :meth:`~RelevanceKernel.score` once (test
+    relevance, leave-one-out training relevance). A matrix kernel is asked ``similarity(test + train,
+    train)`` once when ``need`` has a training-set threshold (the training rows give K(train, train)),
+    else ``similarity(test, train)``: an LM kernel spends no extra calls on the thresholds.
+    """
+    test, train = tuple(test), tuple(train)
+    names = [o.name for o in train]
+    unknown = [r for r in relevant_train if r not in names]
+    if unknown:
+        raise GiftError(f"relevant_train names {unknown}, which are not training objects {names}")
+    if len({o.name for o in test}) != len(test):
+        raise GiftError(f"duplicate test object names: {[o.name for o in test]}")
+    kname = getattr(kernel, "name", type(kernel).__name__)
+    rel_mask = np.array([n in set(relevant_train) for n in names], dtype=bool)
+    need = set(need)
+    want_train = ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1
+    n_fallbacks = len(getattr(kernel, "fallbacks", ()))
+    train_mean = loo_scores = loo_labels = None
+    details: dict[str, Any] = {}
+    if isinstance(kernel, RelevanceKernel):
+        rs = kernel.score(test, train, intent, tuple(relevant_train))
+        decision = _check_vector(rs.relevance, len(test), kernel, "the test objects")
+        train_r = _check_vector(rs.train_loo, len(train), kernel, "the held-out training objects")
+        mask = np.asarray(rs.relevant, dtype=bool)
+        if mask.shape != (len(train),):
+            raise GiftError(f"kernel {kname!r}: RelevanceScores.relevant must be [{len(train)}] booleans")
+        K = np.where(mask[None, :], decision[:, None], 0.0)
+        target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
+        aligned = decision
+        details = dict(rs.details)
+        if want_train:
+            Ktt = np.where(mask[None, :], train_r[:, None], 0.0)
+            train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
+            if "train-calibrated" in need and relevant_train:
+                loo_labels = rel_mask.copy()
+                # a relevant object with no relevant partner left cannot be scored as a positive
+                lonely = rel_mask & (rel_mask.sum() < 2)
+                loo_scores = np.where(lonely, NEVER, train_r)
+    else:
+        rows = test + train if want_train else test
+        K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
+                              "the test objects" + (" and the training objects" if want_train else ""))
+        K, Ktt = K_all[:len(test)], (K_all[len(test):] if want_train else None)
+        decision, target = matrix_decision(K, rel_mask)
+        aligned = K[np.arange(len(test)), target] if len(train) else np.zeros(len(test))
+        if Ktt is not None:
+            train_mean = float(Ktt[~np.eye(len(train), dtype=bool)].mean())
+            if "train-calibrated" in need and relevant_train:
+                loo_labels = rel_mask.copy()
+                loo_scores, _ = matrix_decision(Ktt, rel_mask, valid=~np.eye(len(train), dtype=bool))
+    fallbacks = tuple(getattr(kernel, "fallbacks", ()))[n_fallbacks:]  # LM answers completed by default
+    return AlignmentScores(test=tuple(o.name for o in test), train=tuple(names),
+                           relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
+                           aligned=aligned, kernel=kname, train_mean=train_mean, loo_scores=loo_scores,
+                           loo_labels=loo_labels, fallbacks=fallbacks, details=details)
+
+
+def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:
+    """The paper's bound L · Σ_t (1 − K(f_ω(s'_t), s'_t | ω)) for each of N test trajectories: ``[N]``.
+
+    ``features`` are the *test* features ``[N, T, F]``. The dissimilarity of state t is the largest
+    ``1 − K`` over the aligned objects that are present in it — an object whose semantic features are
+    all 0 at t (absent or far) contributes nothing to a reward linear in those features, so its
+    alignment cannot change that state's reward. Distractors are dropped, not aligned: they add 0.
+    Tighter than :meth:`Alignment.error_bound`, which charges every step for every aligned object.
+    """
+    if lipschitz < 0:
+        raise GiftError(f"the Lipschitz constant must be >= 0, got {lipschitz}")
+    gaps = np.zeros(len(features.specs))
+    for f, spec in enumerate(features.specs):
+        if spec.semantic and alignment.target(spec.subject) != DISTRACTOR:
+            gaps[f] = 1.0 - float(alignment.scores.get(spec.subject, 1.0))
+    present = features.values != 0.0  # [N, T, F]
+    per_state = np.max(np.where(present, gaps, 0.0), axis=-1, initial=0.0)  # [N, T]
+    return lipschitz * per_state.sum(axis=-1)
+
+
+@attrs.frozen
+class AlignedFeatures:
+    """f_ω(ξ') for N test trajectories: aligned ``features`` ``[N, T, F_train]`` and ``error_bounds`` ``[N]``."""
+
+    features: FeatureBatch
+    error_bounds: np.ndarray = attrs.field(eq=False)
+    alignment: Alignment
+
+
+class ArgmaxThresholdAlignment(AlignmentOperator):
+    """argmax over training objects; DISTRACTOR below ``threshold`` (oracle, non-oracle, train-calibrated, float)."""
+
+    name: ClassVar[str] = "argmax-threshold"
+
+    def __init__(self, threshold: str | float = "non-oracle", lipschitz: float = 1.0) -> None:
+        if isinstance(threshold, str):
+            try:
+                threshold = float(threshold)
+            except ValueError:
+                if threshold not in THRESHOLDS:
+                    raise GiftError(f"unknown threshold {threshold!r}; use one of {THRESHOLDS} or a number "
+                                    f"in [0, 1]") from None
+        if not isinstance(threshold, str) and not 0.0 <= float(threshold) <= 1.0:
+            raise GiftError(f"a fixed alignment threshold must be in [0, 1], got {threshold}")
+        self.threshold = threshold
+        self.lipschitz = float(lipschitz)
+        #: how the last threshold was chosen (for reports)
+        self.last_note = ""
+
+    def __repr__(self) -> str:
+        return f"ArgmaxThresholdAlignment(threshold={self.threshold!r})"
+
+    def align(self, kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+              intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+              test_labels: Mapping[str, bool] | None = None) -> Alignment:
+        """Map every test object to a training object or DISTRACTOR (``test_labels`` only for oracle)."""
+        need = () if not isinstance(self.threshold, str) else (self.threshold,)
+        if self.threshold == "train-calibrated":
+            need = ("train-calibrated", "non-oracle")
+        scores = score_alignment(kernel, test, train, intent, relevant_train=relevant_train, need=need)
+        cut, self.last_note = scores.threshold(self.threshold, test_labels)
+        return scores.alignment(cut)
+
+    def transform(self, features: FeatureBatch, alignment: Alignment,
+                  train_specs: Sequence[FeatureSpec]) -> AlignedFeatures:
+        """Apply f_ω to a batch (a trajectory is a batch of one; a state a trajectory of one step).
+
+        Continuous components (features with no subject) pass through unchanged.
+        """
+        return AlignedFeatures(features=align_features(features, alignment, train_specs),
+                               error_bounds=trajectory_error_bounds(features, alignment, self.lipschitz),
+                               alignment=alignment)

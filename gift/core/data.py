@@ -443,6 +443,43 @@ class Alignment:
         return float(lipschitz * n_steps * (max(gaps) if gaps else 0.0))
 
 
+def _vector(value: Any) -> np.ndarray:
+    return np.asarray(value, dtype=float).reshape(-1)
+
+
+@attrs.frozen
+class RelevanceScores:
+    """One scoring pass of a relevance kernel over a test scene (:meth:`RelevanceKernel.score`).
+
+    ``relevance`` ``[n_test]`` in [0, 1]: how much each test object is one of the things the intent is
+    about (0.5 = undecided). ``train_loo`` ``[n_train]`` in [0, 1]: the same score for each training
+    object, computed as if it were new, against the *other* training objects (leave-one-out), on the
+    test objects' scale: what a training-set threshold separates. ``relevant`` ``[n_train]`` bool: the
+    training objects the scores treat as relevant (the given ``relevant_train``, or the kernel's own
+    guess when none was given). ``details``: JSON-able notes for reports (e.g. the category asked about
+    and the weight of each term).
+    """
+
+    relevance: np.ndarray = attrs.field(converter=_vector, eq=False)
+    train_loo: np.ndarray = attrs.field(converter=_vector, eq=False)
+    relevant: np.ndarray = attrs.field(converter=lambda v: np.asarray(v, dtype=bool).reshape(-1), eq=False)
+    details: Mapping[str, Any] = attrs.field(factory=dict, converter=dict, eq=False)
+
+    def __attrs_post_init__(self) -> None:
+        for name in ("relevance", "train_loo"):
+            v = getattr(self, name)
+            if v.size and (not np.all(np.isfinite(v)) or v.min() < -1e-9 or v.max() > 1 + 1e-9):
+                raise ValidationError(f"RelevanceScores.{name} must be finite values in [0, 1], got {v}")
+        if self.relevant.shape != self.train_loo.shape:
+            raise ValidationError(f"RelevanceScores: relevant has {self.relevant.size} entries for "
+                                  f"{self.train_loo.size} training objects")
+
+    @property
+    def K(self) -> np.ndarray:
+        """``[n_test, n_train]``: the relevance of each test object in the relevant training columns, 0 elsewhere."""
+        return np.where(self.relevant[None, :], self.relevance[:, None], 0.0)
+
+
 # ----------------------------------------------------------------------------- LM messages
 
 

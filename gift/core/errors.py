@@ -35,6 +35,10 @@ class PluginError(GiftError):
     """A plugin problem: duplicate component names, an unknown component, a bad registration."""
 
 
+class ComponentOptionError(PluginError, TypeError):
+    """Options a component's factory does not take (or a required one missing); the message lists the valid ones."""
+
+
 class UnknownComponentError(PluginError, KeyError):
     """No component of that kind has that name."""
 

@@ -34,7 +34,7 @@ and keeps every completed result in ``error.completed`` so nothing already compu
 LM concurrency: :class:`RateLimit` caps how many calls to one LM backend run at once across all
 processes of a machine (a set of ``flock``-ed slot files; a slot held by a process that dies is freed
 by the kernel). :meth:`Executor.rate_limit` returns the right limiter for an executor (the Ray plugin
-returns a cluster-wide one); :class:`RateLimitedLM` wraps any :class:`~gift.core.interfaces.LMBackend`.
+returns a cluster-wide one); ``gift_llm.wrappers.RateLimitedLM`` wraps any LM backend with one.
 
 CLI commands that run sweeps call :func:`add_executor_argument` on their parser and
 :func:`executor_from_args` in ``run``; Python functions that take an ``executor=`` argument (an instance,
@@ -51,6 +51,7 @@ import hashlib
 import math
 import os
 import pickle
+import sys
 import tempfile
 import threading
 import time
@@ -62,9 +63,7 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from gift.core.data import Completion, Message
 from gift.core.errors import GiftError, ValidationError
-from gift.core.interfaces import LMBackend
 
 DEFAULT_EXECUTOR = "local"
 
@@ -275,12 +274,75 @@ def _limit_worker_threads(threads: int | None) -> None:
     threadpool_limits(threads)
 
 
+#: Seconds between two checks of the watcher thread that ends an orphaned worker.
+PARENT_POLL_S = 0.2
+#: Exit status of a worker that ended because the process that started it died.
+ORPHAN_EXIT_STATUS = 75
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _exit_if_orphaned(expected_parent: int) -> None:
+    if os.getppid() != expected_parent:  # re-parented (to init or a subreaper): the parent is gone
+        os._exit(ORPHAN_EXIT_STATUS)
+
+
+def _set_parent_death_signal(signum: int) -> bool:
+    """Linux: ask the kernel to send ``signum`` to this process when its parent dies (``prctl``)."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signum), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def die_with_parent(poll_s: float = PARENT_POLL_S) -> None:
+    """Make this process end when its parent process dies, even by ``SIGKILL`` (call it in a child).
+
+    Two mechanisms, both checking that the parent *process* is gone (the process was re-parented), so the
+    end of one thread of the parent does not count:
+
+    - Linux: ``prctl(PR_SET_PDEATHSIG, SIGHUP)`` with a handler that exits at once (an idle worker blocked
+      on its task queue wakes up immediately);
+    - everywhere: a daemon thread that checks ``os.getppid()`` every ``poll_s`` seconds.
+
+    An orphaned process exits with :data:`ORPHAN_EXIT_STATUS` without running cleanup (its results have
+    nobody to go to).
+    """
+    import signal
+
+    parent = os.getppid()
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGHUP, lambda signum, frame: _exit_if_orphaned(parent))
+        _set_parent_death_signal(signal.SIGHUP)
+
+    def watch() -> None:
+        while True:
+            time.sleep(poll_s)
+            _exit_if_orphaned(parent)
+
+    threading.Thread(target=watch, name="gift-parent-watch", daemon=True).start()
+    _exit_if_orphaned(parent)  # the parent may have died before the watch started
+
+
+def _init_worker(threads: int | None) -> None:
+    """Pool initializer: end with the parent process (:func:`die_with_parent`), cap BLAS/OpenMP threads."""
+    die_with_parent()
+    _limit_worker_threads(threads)
+
+
 class LocalExecutor(Executor):
     """A process pool on this machine (``spawn`` start method, so it is safe with threads and Drake).
 
     ``max_workers``: processes (default ``os.cpu_count()``). ``threads_per_worker``: BLAS/OpenMP
     threads in each worker (default ``max(1, cpu_count // max_workers)``; ``0`` leaves them alone).
     The pool starts on the first :meth:`map` and is reused until :meth:`close`.
+
+    Workers die with the process that started them (:func:`die_with_parent`): killing a sweep, even with
+    ``kill -9``, leaves no worker running on (and calling the LM) in the background.
     """
 
     name: ClassVar[str] = "local"
@@ -317,7 +379,7 @@ class LocalExecutor(Executor):
 
                 self._pool = ProcessPoolExecutor(
                     max_workers=self._max_workers, mp_context=multiprocessing.get_context(self.start_method),
-                    initializer=_limit_worker_threads, initargs=(self.threads_per_worker,))
+                    initializer=_init_worker, initargs=(self.threads_per_worker,))
             return self._pool
 
     def map(self, fn: Callable[[Any], Any], items: Iterable[Any], *, chunksize: int | None = None) -> list[Any]:
@@ -528,35 +590,6 @@ class RateLimit(ConcurrencyLimit):
         return f"RateLimit(max_concurrent={self.max_concurrent}, key={self.key!r}, directory={self.directory!r})"
 
 
-class RateLimitedLM(LMBackend):
-    """Any LM backend with its calls capped by a :class:`ConcurrencyLimit`.
-
-    ``identity()`` is the wrapped backend's, so caches keyed by it are shared with the unwrapped backend.
-    Put the limit *inside* a cache when you can (only misses need a slot); wrapping a cached backend
-    is correct but holds a slot during hits too.
-    """
-
-    name: ClassVar[str] = "rate-limited"
-
-    def __init__(self, backend: LMBackend, limit: ConcurrencyLimit) -> None:
-        if not isinstance(backend, LMBackend):
-            raise ValidationError(f"RateLimitedLM: backend must be an LMBackend, got {type(backend).__name__}")
-        self.backend, self.limit = backend, limit
-        self.model = backend.model
-        self.supports_choice_probabilities = backend.supports_choice_probabilities
-
-    def complete(self, messages: Sequence[Message], **kwargs: Any) -> Completion:
-        with self.limit:
-            return self.backend.complete(messages, **kwargs)
-
-    def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
-        with self.limit:
-            return self.backend.choice_probabilities(messages, choices)
-
-    def identity(self) -> str:
-        return self.backend.identity()
-
-
 @contextlib.contextmanager
 def limited(limit: ConcurrencyLimit | None) -> Iterator[None]:
     """``with limited(limit_or_None):`` - hold a slot when a limit is given, do nothing otherwise."""
@@ -569,7 +602,7 @@ def limited(limit: ConcurrencyLimit | None) -> Iterator[None]:
 
 __all__ = [
     "DEFAULT_EXECUTOR", "ConcurrencyLimit", "ExecutionError", "Executor", "ExecutorError", "ItemFailure",
-    "LocalExecutor", "RateLimit", "RateLimitedLM", "SerialExecutor", "add_executor_argument", "assemble",
-    "check_picklable", "chunk_bounds", "default_lock_directory", "executor_from_args", "get_executor",
-    "item_seeds", "limited", "run_chunk", "using_executor",
+    "LocalExecutor", "RateLimit", "SerialExecutor", "add_executor_argument", "assemble",
+    "check_picklable", "chunk_bounds", "default_lock_directory", "die_with_parent", "executor_from_args",
+    "get_executor", "item_seeds", "limited", "run_chunk", "using_executor",
 ]

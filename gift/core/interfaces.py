@@ -5,6 +5,7 @@ Paper                                      Code
 =========================================  ============================================
 ω̂ = J(D_H, D_¬H)                           :meth:`IntentEstimator.estimate`
 K(s, s' | ω) ∈ [0, 1]                      :meth:`SimilarityKernel.similarity` -> [n_test, n_train]
+per-object relevance under ω              :meth:`RelevanceKernel.score` -> RelevanceScores
 f_ω(s') = argmax_s K(s, s' | ω)            :meth:`AlignmentOperator.align`
 f_ω(ξ') (semantic components only)         :func:`gift.core.alignment.align_features`
 R_θ(ξ)                                     :meth:`RewardModel.score`
@@ -32,6 +33,7 @@ from gift.core.data import (
     Intent,
     Message,
     ObjectSpec,
+    RelevanceScores,
     Scene,
     TrajectoryBatch,
 )
@@ -114,6 +116,40 @@ class LMBackend(abc.ABC):
         """Stable identity for caches: backend name and model."""
         return f"{self.name}:{self.model}"
 
+    def provenance(self) -> dict[str, Any]:
+        """What a result made with this LM records about it: ``identity`` and, for a model loaded from a
+        file, ``model_path`` and ``model_sha256`` of the file actually loaded."""
+        return {"identity": self.identity()}
+
+
+#: Environment variable holding the request timeout of LM backends in seconds (``--lm-timeout`` sets it).
+LM_TIMEOUT_ENV = "GIFT_LM_TIMEOUT"
+#: Request timeout of backends that call a server, when neither an option nor the environment sets one.
+DEFAULT_LM_TIMEOUT_S = 120.0
+
+
+def lm_timeout_s(default: float | None = DEFAULT_LM_TIMEOUT_S) -> float | None:
+    """The request timeout of LM backends in seconds: ``$GIFT_LM_TIMEOUT`` when set, else ``default``.
+
+    A backend that calls a server gives up on a request (retries included) after this long. In-process
+    backends (a model in this process) have nothing that can stall and are bounded by ``max_tokens``.
+    """
+    import os
+
+    raw = os.environ.get(LM_TIMEOUT_ENV, "").strip()
+    if not raw:
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        from gift.core.errors import ValidationError
+
+        raise ValidationError(f"{LM_TIMEOUT_ENV}={raw!r}: the LM request timeout must be a positive number of "
+                              f"seconds")
+    return value
+
 
 class IntentEstimator(abc.ABC):
     """J(D_H, D_¬H): infers the intent behind preferred-vs-default demonstrations."""
@@ -137,6 +173,32 @@ class SimilarityKernel(abc.ABC):
     def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                    intent: Intent | None = None) -> np.ndarray:
         """K as a matrix ``[n_test, n_train]`` with values in [0, 1]."""
+
+
+class RelevanceKernel(SimilarityKernel):
+    """A kernel that scores each object once per scene: how much it is one of the things the intent is about.
+
+    The alignment contract (:func:`gift.core.alignment.score_alignment`) calls :meth:`score` exactly once
+    per test scene; there is no hidden state between calls. K follows from the scores
+    (:attr:`RelevanceScores.K`): the relevance of a test object in the columns of the relevant training
+    objects, 0 elsewhere, so the paper's argmax rule gives the same decisions.
+    """
+
+    @abc.abstractmethod
+    def score(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
+              relevant_train: Sequence[str] = ()) -> RelevanceScores:
+        """Relevance ``[n_test]``, leave-one-out training relevance ``[n_train]`` and the relevant mask.
+
+        ``relevant_train``: the training objects the demonstrations treat as part of the goal (inferred
+        from them, or given); empty: the kernel guesses them itself.
+        """
+
+    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                   intent: Intent | None = None) -> np.ndarray:
+        """``[n_test, n_train]`` from one :meth:`score` pass (no relevant training objects given)."""
+        if not len(test) or not len(train):
+            return np.zeros((len(test), len(train)))
+        return self.score(test, train, intent).K
 
 
 class AlignmentOperator(abc.ABC):

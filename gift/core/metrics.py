@@ -129,3 +129,56 @@ def cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a = a / np.maximum(np.linalg.norm(a, axis=-1, keepdims=True), 1e-12)
     b = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 1e-12)
     return a @ b.T
+
+
+# ----------------------------------------------------------------------------- alignment on labelled test objects
+
+
+def subset_metrics(decision: np.ndarray, labels: np.ndarray, cut: float) -> dict[str, float]:
+    """Counts and rates of ``decision >= cut`` against ``labels``, plus AUC of ``decision`` (NaN: one class)."""
+    m = binary_metrics(np.asarray(decision) >= cut, labels)
+    out: dict[str, float] = {"n": int(np.asarray(labels).size), **m.as_dict()}
+    out["auc"] = roc_auc(decision, labels) if np.asarray(labels).size else float("nan")
+    return out
+
+
+def alignment_metrics(decision: np.ndarray, labels: Sequence[bool], subsets: dict[str, np.ndarray],
+                      cuts: dict[str, float]) -> dict[str, dict[str, dict[str, float]]]:
+    """``{threshold: {subset: metrics}}`` of one intent: ``decision`` ``[n]``, ``labels`` ``[n]``,
+    ``subsets`` name -> membership mask ``[n]`` (empty subsets are left out), ``cuts`` threshold -> cut."""
+    y = np.asarray(labels, dtype=bool)
+    d = np.asarray(decision, dtype=float)
+    return {thr: {sub: subset_metrics(d[mask], y[mask], cut) for sub, mask in subsets.items() if mask.any()}
+            for thr, cut in cuts.items()}
+
+
+def pooled_alignment_metrics(per_intent: Sequence[tuple[np.ndarray, np.ndarray, dict[str, np.ndarray],
+                                                        dict[str, float], dict[str, dict[str, dict[str, float]]]]],
+                             thresholds: Sequence[str], subsets: Sequence[str]) -> dict[str, dict[str, dict]]:
+    """Metrics pooled over intents (micro: counts summed) plus the mean per-intent F1 and AUC.
+
+    ``per_intent``: ``(decision, labels, subset masks, cuts, that intent's alignment_metrics)`` tuples.
+    """
+    import math
+
+    out: dict[str, dict[str, dict]] = {}
+    for thr in thresholds:
+        out[thr] = {}
+        for sub in subsets:
+            preds, labels, f1s, aucs = [], [], [], []
+            for decision, y, masks, cuts, metrics in per_intent:
+                mask = masks.get(sub)
+                if mask is None or not mask.any():
+                    continue
+                preds.append(np.asarray(decision)[mask] >= cuts[thr])
+                labels.append(np.asarray(y, dtype=bool)[mask])
+                f1s.append(metrics[thr][sub]["f1"])
+                aucs.append(metrics[thr][sub]["auc"])
+            if not labels:
+                continue
+            p, y_all = np.concatenate(preds), np.concatenate(labels)
+            m = binary_metrics(p, y_all)
+            finite = [a for a in aucs if a is not None and not math.isnan(a)]
+            out[thr][sub] = {"n": int(y_all.size), **m.as_dict(), "f1_mean_intent": float(np.mean(f1s)),
+                             "auc_mean_intent": float(np.mean(finite)) if finite else float("nan")}
+    return out

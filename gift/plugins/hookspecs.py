@@ -14,9 +14,13 @@ an entry point in the group ``gift``::
     def gift_register_kernels(register):
         register("my-kernel", MyKernel, description="cosine of my embeddings")
 
-Every hook receives a ``register(name, factory, *, description="")`` callable. ``factory`` builds the
-component (a class or any callable); ``gift.get_kernel("my-kernel", **options)`` calls
-``factory(**options)``. Two plugins registering the same name for the same kind is an error naming both.
+Every ``gift_register_*`` hook receives a ``register(name, factory, *, description="")`` callable.
+``factory`` builds the component (a class or any callable); ``gift.get_kernel("my-kernel", **options)``
+calls ``factory(**options)``. A component's name has one source: a class with a ``name`` attribute can
+be registered as ``register(MyKernel)``; a name given next to it must equal it, and a component built by
+a function must carry the name it was registered under (checked when it is built). Unknown options are
+rejected with the valid ones listed. Two plugins registering the same name for the same kind is an
+error naming both.
 """
 
 from __future__ import annotations
@@ -102,6 +106,13 @@ def gift_register_reward_models(register: Register) -> None:
 @hookspec
 def gift_register_lm_backends(register: Register) -> None:
     """Register :class:`gift.core.interfaces.LMBackend` factories (``llamacpp``, ``litellm``, ...)."""
+
+
+@hookspec(firstresult=True)
+def gift_resolve_lm(spec: str | None, options: dict) -> Any:
+    """Build the LM for ``spec`` (None: the default; ``"backend:model"``; a registered backend name) with
+    ``options``, wrapped as the plugin sees fit (cache, recording). The first plugin that returns an
+    :class:`~gift.core.interfaces.LMBackend` wins (``gift-llm`` implements it). Called by :func:`gift.resolve_lm`."""
 
 
 @hookspec

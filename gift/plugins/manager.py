@@ -14,16 +14,17 @@ from __future__ import annotations
 
 import importlib
 import importlib.metadata
+import inspect
 import os
 import threading
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 import attrs
 import pluggy
 
-from gift.core.errors import PluginError, UnknownComponentError
+from gift.core.errors import ComponentOptionError, PluginError, UnknownComponentError
 from gift.plugins import hookspecs
 
 ENTRY_POINT_GROUP = "gift"
@@ -44,7 +45,7 @@ KINDS: dict[str, str] = {
     "command": "gift_register_commands",
 }
 
-BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors")
+BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators")
 #: Called once per registered robot (``robot=spec``); what it registers is of kind ``simulator``.
 ROBOT_SIMULATOR_HOOK = "gift_register_robot_simulators"
 
@@ -66,15 +67,52 @@ class Component:
     extra: dict = attrs.field(factory=dict)
 
     def create(self, **options: Any) -> Any:
-        if self.kind == "robot":  # a robot is registered as data (a RobotSpec), not as a factory
+        """``factory(**options)``; options the factory does not take are a :class:`ComponentOptionError`
+        listing the valid ones (checked against its signature before it is called). A robot is registered
+        as data (a :class:`~gift.core.robots.RobotSpec`) and returned as it is."""
+        if self.kind == "robot":
             if options:
                 raise PluginError(f"robot {self.name!r} is a RobotSpec and takes no options, got {sorted(options)}")
             return self.factory
+        self.check_options(options)
         return self.factory(**options)
+
+    def options(self) -> list[str] | None:
+        """Names of the options the factory takes (None when it takes any keyword or has no signature)."""
+        params = _parameters(self.factory)
+        if params is None or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params):
+            return None
+        return [p.name for p in params
+                if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)]
+
+    def check_options(self, options: Mapping[str, Any]) -> None:
+        """Raise :class:`ComponentOptionError` if ``options`` do not fit the factory's signature."""
+        params = _parameters(self.factory)
+        if params is None:
+            return
+        valid = self.options()
+        unknown = sorted(set(options) - set(valid)) if valid is not None else []
+        what = f"{self.kind} {self.name!r} (plugin {self.plugin!r})"
+        listed = ", ".join(valid) if valid else "none"
+        if unknown:
+            raise ComponentOptionError(f"{what} has no option{'s' if len(unknown) > 1 else ''} "
+                                       f"{', '.join(map(repr, unknown))}; valid options: {listed}")
+        try:
+            inspect.Signature(params).bind(**options)
+        except TypeError as e:  # a required option is missing
+            raise ComponentOptionError(f"{what}: {e}; valid options: {listed}") from None
 
     def as_dict(self) -> dict[str, str]:
         return {"kind": self.kind, "name": self.name, "plugin": self.plugin, "distribution": self.distribution,
                 "description": self.description}
+
+
+def _parameters(factory: Any) -> list[inspect.Parameter] | None:
+    """The parameters ``factory(**options)`` takes (a class: its ``__init__`` without ``self``), or None."""
+    try:
+        return list(inspect.signature(factory).parameters.values())
+    except (TypeError, ValueError):  # builtins and some C extensions have no signature
+        return None
 
 
 def _env_list(var: str) -> set[str] | None:
@@ -172,12 +210,22 @@ class GiftPluginManager:
     def _registrar(self, kind: str, plugin_name: str, robot: str | None = None) -> Callable[..., None]:
         dist = self._distribution.get(plugin_name, "?")
 
-        def register(name: str, factory: Any, *, description: str = "", help: str = "", **extra: Any) -> None:
+        def register(name: Any, factory: Any = None, *, description: str = "", help: str = "", **extra: Any) -> None:
             description = description or help
+            if factory is None and not isinstance(name, str):  # register(MyKernel): the name is the class's
+                factory, name = name, getattr(name, "name", None)
+                if not isinstance(name, str):
+                    raise PluginError(f"plugin {plugin_name!r} registered a {kind} {factory!r} without a name: "
+                                      f"give it a class attribute 'name' or call register('name', factory)")
             if not isinstance(name, str) or not name.strip():
                 raise PluginError(f"plugin {plugin_name!r} registered a {kind} with an invalid name {name!r}")
             if factory is None:
                 raise PluginError(f"plugin {plugin_name!r} registered {kind} {name!r} without a factory")
+            own = getattr(factory, "name", None) if isinstance(factory, type) else None
+            if isinstance(own, str) and own != name:
+                raise PluginError(f"plugin {plugin_name!r} registered the {kind} class {factory.__name__} as {name!r}, "
+                                  f"but its name attribute is {own!r}: a component's name has one source; "
+                                  f"use register({factory.__name__}) or make them agree")
             if kind == "robot":
                 description = description or _check_robot(plugin_name, name, factory)
             if robot is not None:
@@ -212,7 +260,14 @@ class GiftPluginManager:
             raise UnknownComponentError(f"no {kind} named {name!r}; registered: {known}{hint}") from None
 
     def create(self, kind: str, name: str, **options: Any) -> Any:
-        return self.get(kind, name).create(**options)
+        """Build ``name`` of ``kind``; the built component must carry that name (when it has a ``name``)."""
+        comp = self.get(kind, name)
+        obj = comp.create(**options)
+        own = getattr(obj, "name", None) if kind not in ("suite", "command") else None
+        if isinstance(own, str) and own != name:
+            raise PluginError(f"the {kind} registered as {name!r} by plugin {comp.plugin!r} built a "
+                              f"{type(obj).__name__} named {own!r}: a component's name has one source")
+        return obj
 
     def simulators_for_robot(self, robot: str) -> list[str]:
         """Names of the simulators registered for ``robot`` (through ``gift_register_robot_simulators``)."""

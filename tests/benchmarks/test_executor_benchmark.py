@@ -145,22 +145,27 @@ def test_cached_lm_sweep_throughput(benchmark, executors, filled_lm_cache, confi
 @pytest.fixture(scope="module")
 def evaluation_items():
     """``evaluate-alignment`` items of the language kernel on every gift-paper intent; embeddings cached here."""
-    from gift_kernels.alignment import THRESHOLDS
-    from gift_kernels.evaluation import AlignmentItem, evaluate_item
+    from gift.study.chain import StudyConfig
+    from gift.study.sweeps import AlignItem, align_item
 
     suite = gift.load_suite("gift-paper")
-    items = [AlignmentItem(suite, "language", spec.id, THRESHOLDS) for spec in suite.intents]
-    ref = SerialExecutor().map(evaluate_item, items)  # computes and caches every MiniLM vector
-    assert all(o.result is not None for o in ref), [o.error for o in ref]
+    cfg = StudyConfig(kernels=("language",), intent_source="ground-truth", rq1=False)
+    items = [AlignItem(cfg, suite, "language", spec.id) for spec in suite.intents]
+    ref = SerialExecutor().map(align_item, items)  # computes and caches every MiniLM vector
+    assert all(o.record is not None for o in ref), [o.error for o in ref]
     n = N_ITEMS // len(items)
-    return items * n, [o.result.scores.decision.tobytes() for o in ref] * n
+    return items * n, [_decisions(o) for o in ref] * n
+
+
+def _decisions(outcome) -> list[float]:
+    return [v["decision"] for v in outcome.record["objects"].values()]
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("config", CONFIGS)
 def test_cached_evaluation_sweep_throughput(benchmark, executors, evaluation_items, config):
-    from gift_kernels.evaluation import evaluate_item
+    from gift.study.sweeps import align_item
 
     items, want = evaluation_items
-    _run(benchmark, executors, config, evaluate_item, lambda r: items,
-         lambda items, res: [o.result.scores.decision.tobytes() for o in res] == want)
+    _run(benchmark, executors, config, align_item, lambda r: items,
+         lambda items, res: [_decisions(o) for o in res] == want)

@@ -113,3 +113,46 @@ def test_cli_plugins_json_lists_components_with_distribution(fresh_plugins, caps
     assert "gift" in dists
     assert main(["plugins"]) == 0
     assert "pack_backpack" in capsys.readouterr().out
+
+
+OPTIONS_PLUGIN = """
+import numpy as np
+import gift
+from gift.core.interfaces import SimilarityKernel
+
+class Scaled(SimilarityKernel):
+    name = "scaled"
+    def __init__(self, scale, *, offset=0.0):
+        self.scale, self.offset = scale, offset
+    def similarity(self, test, train, intent=None):
+        return np.full((len(test), len(train)), self.scale + self.offset)
+
+@gift.hookimpl
+def gift_register_kernels(register):
+    register("scaled", Scaled)
+"""
+
+
+def test_unknown_or_missing_options_name_the_component_and_the_valid_options(plugin_dir):
+    from gift.core.errors import ComponentOptionError
+
+    m = GiftPluginManager().load([make_plugin(plugin_dir, "tp_opts", OPTIONS_PLUGIN)])
+    assert m.create("kernel", "scaled", scale=0.5, offset=0.25).scale == 0.5
+    assert m.get("kernel", "scaled").options() == ["scale", "offset"]
+    with pytest.raises(ComponentOptionError) as err:
+        m.create("kernel", "scaled", scale=0.5, nonsense=1, colour="red")
+    assert str(err.value) == ("kernel 'scaled' (plugin 'tp_opts') has no options 'colour', 'nonsense'; "
+                              "valid options: scale, offset")
+    assert isinstance(err.value, TypeError)  # callers that caught the factory's TypeError still do
+    with pytest.raises(ComponentOptionError, match=r"kernel 'scaled' .*missing a required argument: 'scale'; "
+                                                   r"valid options: scale, offset"):
+        m.create("kernel", "scaled")
+
+
+def test_gift_align_lists_the_valid_options_of_a_kernel(capsys):
+    code = main(["align", "--train", "paintbrush", "banana", "--test", "toothbrush", "--kernel",
+                 "language:nonsense=1"])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert "kernel 'language' (plugin 'gift_kernels') has no option 'nonsense'; valid options:" in err
+    assert "use_descriptions" in err

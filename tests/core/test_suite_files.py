@@ -69,6 +69,12 @@ def test_good_suite_loads_with_defaults(tmp_path):
     ("{shape: cylinder, size: [0.01, 0.2], color: [0.6, 0.4, 0.2]}", "{shape: box, size: [a, b, c]}",
      "list of numbers", None, "objects.paintbrush.appearance.size"),
     ("    text: pack art supplies", "    text: 42", "non-empty string", "art_supplies", "text"),
+    # an intent without test items or without relevant training objects has nothing to evaluate: rejected here
+    # instead of failing later (KeyError 'all' in the evaluation report) or silently giving no result
+    ("    test:\n      - {object: molding clay, relevant: true}\n      - {object: toothbrush, relevant: false, "
+     "confounds: [lang, vis]}\n", "    test: []\n", "needs at least one test item", "art_supplies", "test"),
+    ("    relevant_train: [paintbrush, sketchbook]", "    relevant_train: []",
+     "needs at least one relevant training object", "art_supplies", "relevant_train"),
 ])
 def test_each_error_names_file_intent_and_field(tmp_path, old, new, match, intent, field):
     assert old in GOOD
@@ -109,3 +115,41 @@ def test_top_level_errors(tmp_path):
 def test_task_check_can_be_skipped_for_simulator_free_use(tmp_path):
     p = write(tmp_path, GOOD.replace("task: pack_backpack", "task: my_own_family"))
     assert gift.load_suite(p, known_tasks=None).intents[0].task == "my_own_family"
+
+
+def test_non_utf8_bytes_name_the_file_and_the_line(tmp_path):
+    p = tmp_path / "latin1.yaml"
+    p.write_bytes(GOOD.replace("a yellow fruit", "a yellow fruit, caf\xe9 style").encode("latin-1"))
+    with pytest.raises(SuiteError) as err:
+        gift.load_suite(p)
+    line = GOOD.split("\n").index("  banana: {description: a yellow fruit, appearance: {shape: cylinder}}") + 1
+    assert str(p) in str(err.value) and "not UTF-8" in str(err.value) and f"line {line}," in str(err.value)
+    assert "e9" in str(err.value)
+
+
+def test_gift_align_reports_a_non_utf8_suite_without_a_traceback(tmp_path, capsys):
+    from gift.cli import main
+
+    p = tmp_path / "latin1.yaml"
+    p.write_bytes(GOOD.replace("a yellow fruit", "caf\xe9").encode("latin-1"))
+    code = main(["align", "--train", "paintbrush", "banana", "--test", "toothbrush", "--kernel", "vision",
+                 "--suite", str(p)])
+    err = capsys.readouterr().err
+    assert code == 1 and "not UTF-8" in err and str(p) in err and "Traceback" not in err
+
+
+def test_the_paper_suite_and_the_test_suites_still_load():
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    assert gift.load_suite("gift-paper").intents
+    for f in sorted((root / "kernels" / "data").glob("*.yaml")) + [root / "executor" / "data" / "sweep_suite.yaml"]:
+        assert gift.load_suite(f).intents, f
+
+
+def test_the_c_and_the_python_yaml_parsers_give_the_same_suite():
+    from gift.core.suite import _StrictLoader, parse_suite_yaml, read_suite_text
+
+    text = read_suite_text(gift.get_manager().suites()["gift-paper"])
+    assert parse_suite_yaml(text) == parse_suite_yaml(text, pure_python=True)
+    assert _StrictLoader.__mro__[1].__name__ == "CSafeLoader"  # PyYAML here is built with libyaml

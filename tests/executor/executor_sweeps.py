@@ -124,10 +124,10 @@ def max_overlap(intervals: list[tuple[float, float]]) -> int:
 def _cached_lm(cache_path: str, limit: Any, n_ctx: int):
     """Per worker process: the embedded llama.cpp model behind the LM plugin's SQLite cache at
     ``cache_path``; model calls (cache misses only) hold ``limit``."""
-    from gift.core.executor import RateLimitedLM
     from gift_llm.cache import CachedLM
+    from gift_llm.wrappers import RateLimitedLM
 
-    inner = gift.get_lm("llamacpp", n_ctx=n_ctx, n_threads=1)
+    inner = gift.resolve_lm("llamacpp", n_ctx=n_ctx, n_threads=1, cache=False)
     if limit is not None:
         inner = RateLimitedLM(inner, limit)
     return CachedLM(inner, path=cache_path)

@@ -20,7 +20,6 @@ from gift.core.executor import (
     ExecutorError,
     LocalExecutor,
     RateLimit,
-    RateLimitedLM,
     SerialExecutor,
     add_executor_argument,
     chunk_bounds,
@@ -29,6 +28,7 @@ from gift.core.executor import (
     item_seeds,
 )
 from gift.core.interfaces import LMBackend
+from gift_llm.wrappers import RateLimitedLM
 
 import executor_sweeps as sweeps
 

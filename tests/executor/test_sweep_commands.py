@@ -29,7 +29,7 @@ INTENTS = ("art_supplies", "valuables")
 #: two real kernels, one whose constructor fails in the worker, one the parent rejects before any work
 KERNELS = ("language", "vision", "language:use_descriptions=maybe", "no-such-kernel")
 REPRODUCE = ["--kernels", "language,vision", "--intent-source", "ground-truth", "--pairs", "30", "--seeds", "2",
-             "--trajectories", "4", "--train-scenes", "2", "--sanity-reps", "0", "--quiet"]
+             "--trajectories", "4", "--train-scenes", "2", "--sanity-reps", "0"]
 EXECUTORS = {"serial": ["--executor", "serial"], "local": ["--executor", "local", "--workers", "2"],
              "ray": ["--executor", "ray", "--workers", "2"]}
 
@@ -93,9 +93,12 @@ def test_evaluate_alignment_json_is_identical_on_serial_local_and_ray(sweep_runs
         assert result["kernels"][k]["overall"]["oracle"]["all"]["n"] == 12
     assert result["kernels"]["language:use_descriptions=maybe"]["errors"]["*"].startswith("GiftError")
     assert result["kernels"]["no-such-kernel"]["errors"]["*"].startswith("UnknownComponentError")
-    want = canonical(ref["alignment"], {"seconds"})
+    want = canonical(ref["alignment"], {"seconds", "manifest"})
     for name, run in sweep_runs.items():
-        assert canonical(run["alignment"], {"seconds"}) == want, f"evaluate-alignment on {name} differs from serial"
+        assert canonical(run["alignment"], {"seconds", "manifest"}) == want, \
+            f"evaluate-alignment on {name} differs from serial"
+        manifest = json.loads(run["alignment"].read_text())["manifest"]
+        assert manifest["executor"]["name"] == name and manifest["suite"]["sha256"] and manifest["code_version"]
     if "local" not in sweep_runs:
         pytest.fail("the local executor did not run")
 
@@ -118,21 +121,23 @@ def test_reproduce_results_json_is_identical_on_serial_local_and_ray(sweep_runs)
         assert set(results["rq1"][intent]) == {"language", "vision", "oracle-labels"}
         assert len(results["scatter"][intent]["points"]) == 6
     assert "errors" not in results and "lm" not in results["manifest"]  # no LM was needed
-    want = canonical(ref["results"], {"timing", "manifest"})
+    want = canonical(ref["results"], {"timing", "manifest", "seconds"})
     for name, run in sweep_runs.items():
-        assert canonical(run["results"], {"timing", "manifest"}) == want, f"reproduce on {name} differs from serial"
+        assert canonical(run["results"], {"timing", "manifest", "seconds"}) == want, f"reproduce on {name} differs from serial"
         manifest = json.loads(run["results"].read_text())["manifest"]
         assert manifest["executor"] == {"name": name, "max_workers": 1 if name == "serial" else 2}
-        # executor options are not part of the config: same key, same stage-cache layout
+        # executor options are not part of the stage keys: the same stage files on every executor
         stages = sorted(p.relative_to(run["stages"]).as_posix() for p in run["stages"].rglob("*.json"))
-        assert stages == [f"{manifest['config_key']}/align-{i}-{k}.json" for i in INTENTS for k in ("language", "vision")]
+        assert [s.rsplit("-", 1)[0] for s in stages] == [f"{i}/align-{k}" for i in INTENTS for k in ("language", "vision")]
+        assert stages == sorted(p.relative_to(ref["stages"]).as_posix() for p in ref["stages"].rglob("*.json"))
 
 
 def test_reproduce_logs_a_line_per_intent_on_every_executor(sweep_runs):
     for name, run in sweep_runs.items():
         lines = run["reproduce_stderr"]
         for intent in INTENTS:
-            assert f"[{intent}] training the reward on jaco" in lines and f"[{intent}] done: language=" in lines, name
+            assert f"[{intent}] training scenes and demonstrations on jaco" in lines, name
+            assert f"[{intent}] done: language=" in lines, name
     serial = sweep_runs["serial"]["reproduce_stderr"]
     assert serial.index("[art_supplies] done") < serial.index("[valuables] training")  # one intent after the other
 
@@ -147,28 +152,34 @@ def _suite_with_a_failing_intent(path: Path) -> Path:
 
 
 def test_reproduce_failure_serial_raises_the_error_and_a_pool_names_the_intent(tmp_path, capfd, local_executor):
-    from gift_experiments.reproduce import Progress, ReproduceConfig, run
+    from gift.study.chain import StudyConfig
+    from gift.study.progress import Progress
+    from gift.study.sweeps import run_study
 
-    cfg = ReproduceConfig(suite=str(_suite_with_a_failing_intent(tmp_path / "suite.yaml")), kernels=("language",),
+    cfg = StudyConfig(suite=str(_suite_with_a_failing_intent(tmp_path / "suite.yaml")), kernels=("language",),
                           intent_source="ground-truth", pairs=10, seeds=1, train_scenes=1, demos_per_scene=2,
                           alternatives_per_scene=4, trajectories_per_generator=2, sanity_reps=0, rq3=False)
     lines: list[str] = []
     with pytest.raises(GiftError, match="valuables.*needs relevant and irrelevant test objects") as info:
-        run(cfg, tmp_path / "serial", Progress(enabled=True), log=lines.append, executor="serial")
-    assert not isinstance(info.value, ExecutionError)  # serial raises what the intent raised, as before
-    assert len(lines) == 3 and lines[0] == "[art_supplies] training the reward on jaco"
-    assert lines[1].startswith("[art_supplies] done: language=") and lines[2] == "[valuables] training the reward on jaco"
+        run_study(cfg, tmp_path / "serial", Progress(enabled=True), log_line=lines.append, executor="serial")
+    assert not isinstance(info.value, ExecutionError)  # serial raises what the intent raised
+    assert lines[0] == "[art_supplies] training scenes and demonstrations on jaco"
+    done = [i for i, line in enumerate(lines) if line.startswith("[art_supplies] done: language=")]
+    assert len(done) == 1 and all(line.startswith("[valuables]") for line in lines[done[0] + 1:])
+    assert not any(line.startswith("[valuables] done") for line in lines)
     err = capfd.readouterr().err
     assert "intents" in err and "art_supplies: kernels" in err and "art_supplies: RQ1 seeds" in err  # tqdm bars
 
     with pytest.raises(ExecutionError, match=r"item 1 of 2 \(IntentJob\('valuables'") as info:
-        run(cfg, tmp_path / "pool", Progress(enabled=False), log=lines.append, executor=local_executor)
+        run_study(cfg, tmp_path / "pool", Progress(enabled=False), log_line=lines.append, executor=local_executor)
     assert list(info.value.completed) == [0]  # art_supplies finished, and its stages are cached for a resume
-    assert (tmp_path / "pool" / "stages" / cfg.key() / "align-art_supplies-language.json").exists()
+    assert len(list((tmp_path / "pool" / "stages" / "art_supplies").glob("align-language-*.json"))) == 1
 
 
 def test_lm_usage_of_the_workers_is_summed_into_the_manifest():
-    from gift_experiments.reproduce import ReproduceConfig, _merge_lm, _usage_delta, manifest
+    from gift.study.chain import _usage_delta
+    from gift.study.sweeps import manifest
+    from gift.study.sweeps import merge_lm as _merge_lm
 
     before = {"requests": 4, "hits": 1, "misses": 3, "calls": 3, "latency_s": 2.0, "cost_usd": None}
     after = {"requests": 7, "hits": 3, "misses": 4, "calls": 4, "latency_s": 2.5, "cost_usd": None}
@@ -179,9 +190,11 @@ def test_lm_usage_of_the_workers_is_summed_into_the_manifest():
     assert merged == {"identity": "llamacpp:m.gguf", "usage": {"requests": 7, "hits": 3, "misses": 4, "calls": 4,
                                                                 "latency_s": 2.5, "cost_usd": 0.25}}
     assert _merge_lm([None, None]) is None
-    m = manifest(ReproduceConfig(lm="litellm:openai/x"), lm=merged)
+    # a resumed run: the manifest keeps every run and sums their LM usage
+    m = manifest([{"lm": first, "started": "a"}, {"lm": second, "started": "b"}], "key")
     assert m["lm"] == {"identity": "llamacpp:m.gguf", "usage": merged["usage"]}
-    assert "lm" not in manifest(ReproduceConfig())
+    assert [r["started"] for r in m["runs"]] == ["a", "b"] and m["config_key"] == "key"
+    assert "lm" not in manifest([{"started": "a"}], "key")
 
 
 def test_llamacpp_threads_follow_the_worker_budget(local_executor, monkeypatch, tmp_path):
@@ -214,7 +227,7 @@ def test_llamacpp_threads_follow_the_worker_budget(local_executor, monkeypatch, 
 def test_evaluate_alignment_inferred_intents_failing_the_same_way_on_serial_and_local(local_executor):
     """Inferred intents run as their own items first (on a pool); an LM that cannot be built fails every
     intent of every kernel, reported in the result, the same on both executors."""
-    from gift_kernels.evaluation import evaluate_alignment
+    from gift.study.sweeps import evaluate_alignment
 
     got = {}
     for name, executor in (("serial", "serial"), ("local", local_executor)):
@@ -222,7 +235,7 @@ def test_evaluate_alignment_inferred_intents_failing_the_same_way_on_serial_and_
         result = evaluate_alignment(str(SUITE), ["language", "vision"], intent_source="inferred",
                                     lm="no-such-backend:x", progress=lines.append, executor=executor)
         assert len(lines) == 4 and all(": FAILED LMError: unknown LM 'no-such-backend:x'" in line for line in lines)
-        got[name] = json.dumps(without(result, {"seconds"}))
+        got[name] = json.dumps(without(result, {"seconds", "manifest"}))
     assert got["serial"] == got["local"]
     kernels = json.loads(got["serial"])["kernels"]
     assert all(set(k["errors"]) == set(INTENTS) and not k["intents"] for k in kernels.values())

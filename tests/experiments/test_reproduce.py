@@ -4,14 +4,19 @@ on renders, the embedded LM), its report and figures, and the resume of a finish
 from __future__ import annotations
 
 import json
+import os
+import subprocess
 
+import attrs
 import numpy as np
 import pytest
 import yaml
 
 import gift
+from gift.study.chain import ORACLE, StudyConfig
+from gift.study.progress import Progress
+from gift.study.sweeps import run_study
 from gift_experiments.report import headline_table, write_report
-from gift_experiments.reproduce import ORACLE, Progress, ReproduceConfig, run
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm, pytest.mark.drake]
 
@@ -43,12 +48,22 @@ def mini_suite(path):
 
 @pytest.fixture(scope="module")
 def reduced(tmp_path_factory):
+    """The reduced run, every LM call recorded (``GIFT_LM_RECORD``) for the replay test below."""
+    from gift.study import components
+
     out = tmp_path_factory.mktemp("reproduce")
     suite = mini_suite(out / "mini-suite.yaml")
-    cfg = ReproduceConfig(suite=str(suite), kernels=KERNELS, seeds=2, pairs=60, samples=1, train_scenes=2,
+    record = out / "lm-calls.jsonl"
+    components._WORKER.clear()  # a fresh LM, resolved while the recording is on
+    os.environ["GIFT_LM_RECORD"] = str(record)
+    cfg = StudyConfig(suite=str(suite), kernels=KERNELS, seeds=2, pairs=60, samples=1, train_scenes=2,
                           demos_per_scene=4, alternatives_per_scene=12, trajectories_per_generator=6,
                           sanity_reps=1, thresholds=("train-calibrated", "oracle"), rq3=True)
-    results = run(cfg, out, Progress(False), log=lambda m: None)
+    try:
+        results = run_study(cfg, out, Progress(False))
+    finally:
+        del os.environ["GIFT_LM_RECORD"]
+        components._WORKER.clear()
     return cfg, out, results
 
 
@@ -75,7 +90,16 @@ def test_every_stage_produces_numbers_for_every_kernel(reduced):
         assert len(v["objects"]) == 4 and np.isclose(sum(v["mean"]), 1.0), k
     scatter = results["scatter"]["valuables"]["points"]
     assert len(scatter) == N_TEST and all(0.0 <= p["language"] <= 1.0 and 0.0 <= p["vision"] <= 1.0 for p in scatter)
-    assert results["manifest"]["lm"]["usage"]["misses"] > 0
+    manifest = results["manifest"]
+    assert manifest["lm"]["usage"]["misses"] > 0
+    # provenance: the model file actually loaded, the commit of this checkout, the suite file's hash
+    from gift_llm.embedded import EXPECTED_SHA256
+
+    assert manifest["lm"]["model_sha256"] == EXPECTED_SHA256 and manifest["lm"]["identity"].startswith("llamacpp:")
+    head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+    assert manifest["git"]["commit"] == head and manifest["suite"]["sha256"] and manifest["code_version"]
+    # in inferred mode the relevant training objects come from the demonstrations, not the suite
+    assert results["relevant"]["valuables"]["source"] == "demonstrations"
 
 
 def test_report_figures_and_results_json(reduced):
@@ -95,8 +119,11 @@ def test_report_figures_and_results_json(reduced):
 
 
 def test_rerun_resumes_from_the_caches_without_model_calls(reduced):
+    from gift.study.sweeps import previous_runs
+
     cfg, out, results = reduced
-    again = run(cfg, out, Progress(False), log=lambda m: None)
+    again = run_study(cfg, out, Progress(False), previous=previous_runs(out / "results.json"))
+    assert len(again["manifest"]["runs"]) == 2  # the resume adds its record to the first run's
     # NaN (an AUC of a one-class subset) must compare equal to NaN: assert_equal does that
     np.testing.assert_equal(again["rq1"], results["rq1"])
     np.testing.assert_equal(again["rq2"], results["rq2"])
@@ -116,3 +143,15 @@ def test_headline_table_summarises_runs_per_robot(reduced):
     f1 = results["rq2"]["valuables"]["gift-prob"]["train-calibrated"]["all"]["f1"]
     assert rows["gift-prob"].count(f"{wr:.3f}") == 2 and rows["gift-prob"].count(f"{f1:.3f}") == 2
     assert rows[ORACLE].endswith("| – |")  # the label alignment has a win rate but no F1 row
+
+
+def test_a_rerun_with_another_lm_recomputes_every_lm_stage_and_names_that_lm(reduced):
+    """Stage keys cover the resolved LM: the same config with the run's recording as the LM (``replay:``)
+    finds no finished LM stage, recomputes them all from the replay, and gets the same numbers."""
+    cfg, out, results = reduced
+    replay = attrs.evolve(cfg, lm=f"replay:{out / 'lm-calls.jsonl'}")
+    again = run_study(replay, out, Progress(False))
+    lm = again["manifest"]["lm"]
+    assert lm["identity"].startswith("replay:") and lm["usage"]["requests"] > 0  # answered again, not read back
+    np.testing.assert_equal(again["rq2"], results["rq2"])
+    assert again["intents"] == results["intents"]

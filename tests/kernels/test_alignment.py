@@ -6,11 +6,7 @@ import numpy as np
 import pytest
 
 import gift
-from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, ObjectSpec
-from gift.core.errors import GiftError
-from gift.core.interfaces import SimilarityKernel
-from gift.tasks import PackBackpack
-from gift_kernels.alignment import (
+from gift.core.alignment import (
     NEVER,
     ArgmaxThresholdAlignment,
     best_separating_cut,
@@ -19,6 +15,10 @@ from gift_kernels.alignment import (
     score_alignment,
     trajectory_error_bounds,
 )
+from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, ObjectSpec, RelevanceScores
+from gift.core.errors import GiftError
+from gift.core.interfaces import RelevanceKernel, SimilarityKernel
+from gift.tasks import PackBackpack
 
 TRAIN = [ObjectSpec(n) for n in ("paintbrush", "sketchbook", "banana", "coffee mug")]
 TEST = [ObjectSpec(n) for n in ("molding clay", "toothbrush", "apple")]
@@ -39,21 +39,18 @@ class TableKernel(SimilarityKernel):
                           for b in train] for a in test])
 
 
-class RelevanceKernel(TableKernel):
-    """A per-object relevance kernel (like gift-prob): p in the relevant columns."""
+class TableRelevanceKernel(RelevanceKernel):
+    """A per-object relevance table (like gift-prob): one score() per scene, leave-one-out from the same table."""
 
     name = "relevance-table"
 
     def __init__(self, p: dict[str, float]):
-        super().__init__({})
-        self.p, self.relevance_calls = p, 0
+        self.p, self.score_calls = p, 0
 
-    def similarity(self, test, train, intent=None, relevant_train=()):
-        return np.array([[self.p[a.name] if b.name in REL else 0.0 for b in train] for a in test])
-
-    def relevance(self, test, train, intent, relevant_train):
-        self.relevance_calls += 1
-        return np.array([self.p[a.name] for a in test])
+    def score(self, test, train, intent=None, relevant_train=()):
+        self.score_calls += 1
+        rel = [b.name in (relevant_train or REL) for b in train]
+        return RelevanceScores([self.p[a.name] for a in test], [self.p[b.name] for b in train], rel)
 
 
 SIMS = {("molding clay", "paintbrush"): 0.7, ("molding clay", "sketchbook"): 0.5,
@@ -122,17 +119,22 @@ def test_three_thresholds_on_one_scoring_and_train_calibrated_ignores_test_label
 def test_relevance_kernels_use_their_relevance_and_leave_one_out():
     p = {"molding clay": 0.8, "toothbrush": 0.3, "apple": 0.1,
          "paintbrush": 0.9, "sketchbook": 0.7, "banana": 0.2, "coffee mug": 0.4}
-    k = RelevanceKernel(p)
+    k = TableRelevanceKernel(p)
     sc = score_alignment(k, TEST, TRAIN, relevant_train=REL)
     assert sc.decision.tolist() == pytest.approx([0.8, 0.3, 0.1])
     assert sc.loo_scores.tolist() == pytest.approx([0.9, 0.7, 0.2, 0.4])
-    assert k.relevance_calls == 1 + 4  # the test scene, then one per held-out training object
+    assert k.score_calls == 1  # one pass: the test scene and the held-out training objects together
+    # K: the relevance in the relevant columns; the non-oracle cut from the training objects' scores
+    assert np.allclose(sc.K, [[0.8, 0.8, 0, 0], [0.3, 0.3, 0, 0], [0.1, 0.1, 0, 0]])
+    Ktt = np.array([[v if j < 2 else 0.0 for j in range(4)] for v in (0.9, 0.7, 0.2, 0.4)])
+    assert sc.train_mean == pytest.approx(Ktt[~np.eye(4, dtype=bool)].mean())
     cut, _ = sc.threshold("train-calibrated")
     assert cut == pytest.approx((0.4 + 0.7) / 2)
     al = sc.alignment(cut)
     assert al.mapping == {"molding clay": "paintbrush", "toothbrush": DISTRACTOR, "apple": DISTRACTOR}
     # a single relevant training object has no relevant partner: fall back to non-oracle, and say so
     sc1 = score_alignment(k, TEST, TRAIN, relevant_train=("paintbrush",))
+    assert k.score_calls == 2
     cut1, note1 = sc1.threshold("train-calibrated")
     assert "fallback" in note1 and cut1 == pytest.approx(sc1.train_mean)
 
@@ -154,8 +156,11 @@ def test_operator_thresholds_and_errors():
         ArgmaxThresholdAlignment("smart")
     with pytest.raises(GiftError, match=r"\[0, 1\]"):
         ArgmaxThresholdAlignment(1.5)
-    with pytest.raises(GiftError, match="relevant_train"):
-        ArgmaxThresholdAlignment("train-calibrated").align(k, TEST, TRAIN)
+    # no relevant training object known (e.g. demonstrations that single out none): the paper's cut, said so
+    op = ArgmaxThresholdAlignment("train-calibrated")
+    unknown = op.align(k, TEST, TRAIN)
+    assert "no relevant training object" in op.last_note
+    assert unknown.threshold == pytest.approx(score_alignment(k, TEST, TRAIN).threshold("non-oracle")[0])
     with pytest.raises(GiftError, match="not training objects"):
         ArgmaxThresholdAlignment().align(k, TEST, TRAIN, relevant_train=("unicorn",))
 

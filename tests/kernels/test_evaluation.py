@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +11,9 @@ import pytest
 import gift
 from gift.cli import main
 from gift.core.suite import load_suite
-from gift_kernels.evaluation import REPORT_SUBSETS, evaluate_alignment, parse_kernel_spec
+from gift.study.chain import REPORT_SUBSETS
+from gift.study.components import parse_spec
+from gift.study.sweeps import evaluate_alignment
 
 pytestmark = pytest.mark.slow
 
@@ -61,24 +62,44 @@ def test_train_calibrated_uses_no_test_label(tmp_path):
 def test_cli_evaluate_alignment_json_and_table(tmp_path, capsys):
     out = tmp_path / "res.json"
     code = main(["evaluate-alignment", "--suite", SUITE, "--kernels", "language", "--threshold", "non-oracle",
-                 "--intents", "valuables", "--out", str(out), "--quiet"])
+                 "--intents", "valuables", "--out", str(out), "-q"])
     assert code == 0
     table = capsys.readouterr().out
     assert "| language | non-oracle | " in table and "| language | valuables | " in table
     saved = json.loads(out.read_text())
     assert list(saved["kernels"]["language"]["intents"]) == ["valuables"]
     assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", "language", "--threshold", "median",
-                 "--quiet"]) == 1
+                 "-q"]) == 1
     assert "unknown threshold" in capsys.readouterr().err
     assert main(["evaluate-alignment", "--suite", str(tmp_path / "nope.yaml"), "--kernels", "language"]) == 1
     assert "nope.yaml" in capsys.readouterr().err
 
 
-def test_cli_align_with_objects_outside_any_catalog(capsys):
+def test_cli_align_refuses_objects_outside_any_catalog_unless_allowed(capsys, tmp_path):
+    # a name no catalog has would silently be a grey 8 cm cube without a description
+    code = main(["align", "--train", "paintbrush", "flibbertigibbet", "--test", "zzyzx_thing", "--kernel", "vision"])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert "unknown objects 'flibbertigibbet', 'zzyzx_thing': not in the catalog of any registered suite" in err
+    assert "--allow-unknown" in err
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "tooth brush", "--kernel", "vision"]) == 1
+    assert "'tooth brush' (did you mean 'toothbrush'" in capsys.readouterr().err
+    # with --suite FILE, only that file's catalog counts
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "molding clay", "--kernel", "language",
+                 "--suite", SUITE]) == 1
+    assert f"unknown object 'molding clay'" in (err := capsys.readouterr().err) and SUITE in err
+    assert main(["align", "--train", "paintbrush", "banana", "--test", "sketchbook", "--relevant", "sketchbook",
+                 "--kernel", "language"]) == 1
+    assert "--relevant ['sketchbook']: not among the --train objects" in capsys.readouterr().err
+
     code = main(["align", "--train", "paintbrush", "sketchbook", "banana", "--test", "toothbrush", "glue stick",
-                 "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json"])
+                 "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json",
+                 "--allow-unknown"])
     assert code == 0
-    out = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    assert "warning: 1 object(s) in no catalog" in captured.err and "glue stick" in captured.err
+    out = json.loads(captured.out)
+    assert out["unknown_objects"]["names"] == ["glue stick"]
     rows = {r["object"]: r for r in out["alignment"]}
     assert rows["toothbrush"]["target"] == "paintbrush" and rows["toothbrush"]["relevant"] is True
     assert out["threshold"] == 0.5 and np.array(out["similarity"]["K"]).shape == (2, 3)
@@ -89,45 +110,7 @@ def test_cli_align_with_objects_outside_any_catalog(capsys):
 
 
 def test_kernel_specs():
-    assert parse_kernel_spec("language:use_descriptions=true") == ("language", {"use_descriptions": True})
-    assert parse_kernel_spec("gift:samples=3:temperature=0.7") == ("gift", {"samples": 3, "temperature": 0.7})
+    assert parse_spec("language:use_descriptions=true") == ("language", {"use_descriptions": True})
+    assert parse_spec("gift:samples=3:temperature=0.7") == ("gift", {"samples": 3, "temperature": 0.7})
     with pytest.raises(gift.GiftError, match="key=value"):
-        parse_kernel_spec("gift:samples")
-
-
-@pytest.mark.lm
-@pytest.mark.drake
-@pytest.mark.skipif(not os.environ.get("GIFT_RUN_INFERRED_EVAL"),
-                    reason="20+ min on a loaded 2-core machine (Calls 1-2 of the embedded LM); "
-                           "set GIFT_RUN_INFERRED_EVAL=1 to run")
-def test_inferred_intent_runs_the_gift_front_half_and_a_rerun_is_served_from_the_cache():
-    """Drake demonstrations -> lm-contrastive (Calls 1-2) on the embedded LM, for one intent.
-
-    The surface kernel ignores the intent, so its numbers must equal the ground-truth run's; the
-    one-kernel-call-per-scene bound is checked in test_alignment (the LM kernels' sample counts in
-    test_lm_kernels).
-    """
-    from gift_llm import get_default_lm
-
-    from gift_kernels.evaluation import _jsonable, evaluate_kernel, inferred_intent_source
-
-    suite = load_suite(SUITE)
-    lm = get_default_lm()
-    kernel = gift.get_kernel("language")
-
-    def run():
-        before = lm.stats.as_dict()
-        res = evaluate_kernel(kernel, suite, intents=["art_supplies"], intent_for=inferred_intent_source(n_pairs=1))
-        after = lm.stats.as_dict()
-        return res, {k: after[k] - before[k] for k in ("requests", "misses")}
-
-    res, used = run()
-    assert not res.errors, res.errors
-    (r,) = res.intents
-    assert r.intent_text.strip() and r.intent_text != "pack art supplies"  # inferred, not the label
-    assert 2 <= used["requests"] <= 2 * 3  # Calls 1 and 2, each with at most 2 repairs
-    truth = evaluate_kernel(kernel, suite, intents=["art_supplies"])
-    assert _jsonable(truth.intents[0].metrics) == _jsonable(r.metrics)  # NaN AUCs (one-class subsets) -> None
-    res2, used2 = run()
-    assert used2["misses"] == 0  # the rerun is served from the LM cache
-    assert res2.intents[0].intent_text == r.intent_text
+        parse_spec("gift:samples")

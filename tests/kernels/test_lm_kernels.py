@@ -19,7 +19,8 @@ from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift.core.suite import load_suite
 from gift_kernels import prompts
-from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_mapping
+from gift_kernels.lm_kernels import (GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_category_answer,
+                                     parse_mapping)
 
 SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
 
@@ -51,6 +52,11 @@ class ScriptedLM(LMBackend):
 
 class PlainLM(ScriptedLM):
     supports_choice_probabilities = False
+
+
+def category_json(category: str) -> str:
+    """A category answer in the JSON of ``schemas.category_schema``."""
+    return json.dumps({"category": category})
 
 
 def _names_in_order(text: str, key: str) -> list[str]:
@@ -144,54 +150,52 @@ def _probs_by_name(table):
 def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
              "toothbrush": 0.4, "apple": 0.05}
-    lm = ScriptedLM(answer=lambda m, s: "Art supplies.", probs=_probs_by_name(table))
+    lm = ScriptedLM(answer=lambda m, s: category_json("Art supplies."), probs=_probs_by_name(table))
     k = GiftProbKernel(lm=lm, combine="none", category_from="goal")
     lo = k.log_odds(TEST, ART)
     assert np.allclose(lo, [np.log(0.7 / 0.3), np.log(0.4 / 0.6), np.log(0.05 / 0.95)])
-    r = k.relevance(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
-    assert np.allclose(r, [0.7, 0.4, 0.05])
+    rs = k.score(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
+    assert np.allclose(rs.relevance, [0.7, 0.4, 0.05])
+    assert np.allclose(rs.train_loo, [0.9, 0.8, 0.2, 0.1])  # the same questions of the training objects
     # K: r_i in the relevant columns (given, or the training objects the LM itself calls relevant), 0 elsewhere
-    for K in (k.similarity(TEST, TRAIN, ART), k.similarity(TEST, TRAIN, ART, relevant_train=("paintbrush",
-                                                                                               "sketchbook"))):
+    for K in (k.similarity(TEST, TRAIN, ART), rs.K):
         assert np.allclose(K, np.outer([0.7, 0.4, 0.05], [1, 1, 0, 0]))
-    assert np.allclose(k.loo_relevance(TRAIN, ART, ("paintbrush", "sketchbook")), [0.9, 0.8, 0.2, 0.1])
     n_calls = len(lm.calls)
-    k.relevance(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
+    k.score(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
     assert len(lm.calls) == n_calls == k.calls == 1 + len(TEST) + len(TRAIN)  # each question asked once
     # first the category, once per goal (greedy, few-shot), then one yes/no question per object
     first, questions = lm.calls[0], lm.calls[1:]
     assert first[0][0].content == prompts.CATEGORY_SYSTEM and first[2] == 0.0
-    assert first[0][-1].content.startswith("Goal: pack art supplies.") and k.categories == {
-        "pack art supplies": "Art supplies"}
+    assert first[0][-1].content.startswith("Goal: pack art supplies.") and rs.details["category"] == "Art supplies"
     assert all(m[0][0].content == prompts.RELEVANCE_SYSTEM for m in questions)
     assert questions[0][0][1].content.startswith("Is a crayons (sticks of colored wax) one of the Art supplies?")
 
 
 def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects_leaving_each_one_out():
     def answer(messages, seed):  # the category the scripted LM names: from the last question's handled objects
-        m = re.search(r"handled as part of this goal: (.*)\.\n", messages[-1].content)
-        return "drawing books" if m and "paintbrush" not in m.group(1) else "art supplies"
+        m = re.search(r"kept clear of them\): (.*)\.\n", messages[-1].content)
+        return category_json("drawing books" if m and "paintbrush" not in m.group(1) else "art supplies")
 
     lm = ScriptedLM(answer=answer, probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2,
                                                           "coffee mug": 0.1, "crayons": 0.7, "toothbrush": 0.4,
                                                           "apple": 0.05}))
     k = GiftProbKernel(lm=lm, combine="none")  # category_from="goal+objects" is the default
     intent = Intent(text="The person wanted to pick up the sketchbook.", source="inferred")
-    s_test, s_train = k.scores(TEST, TRAIN, intent, ("paintbrush", "sketchbook"))
-    assert np.allclose(s_test, np.log([0.7 / 0.3, 0.4 / 0.6, 0.05 / 0.95]))
+    rs = k.score(TEST, TRAIN, intent, ("paintbrush", "sketchbook"))
+    assert np.allclose(rs.relevance, [0.7, 0.4, 0.05])
     cats = [c[0][-1].content for c in lm.calls if c[0][0].content == prompts.CATEGORY_SYSTEM]
     # the full question, then one per training object, named without it
     assert len(cats) == 1 + len(TRAIN)
     assert cats[0].startswith("Goal: pick up the sketchbook.\n") and \
-        "handled as part of this goal: paintbrush, sketchbook.\nObjects they left alone: banana, coffee mug." in cats[0]
-    assert "handled as part of this goal: sketchbook.\nObjects they left alone: banana, coffee mug." in cats[1]
-    assert "left alone: coffee mug." in cats[3] and "left alone: banana." in cats[4]
+        "them): paintbrush, sketchbook.\nObjects it did not concern: banana, coffee mug." in cats[0]
+    assert "them): sketchbook.\nObjects it did not concern: banana, coffee mug." in cats[1]
+    assert "did not concern: coffee mug." in cats[3] and "did not concern: banana." in cats[4]
     questions = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
     assert "Is a crayons (sticks of colored wax) one of the art supplies? Answer yes or no." in questions
     assert any(q.startswith("Is a paintbrush (a brush for paint) one of the drawing books?") for q in questions)
-    assert k.categories == {"pick up the sketchbook": "art supplies"}  # what the test objects were asked about
+    assert rs.details["category"] == "art supplies"  # what the test objects were asked about
     # without demonstrated objects it names the category from the goal alone
-    k.scores(TEST, TRAIN, ART)
+    k.score(TEST, TRAIN, ART)
     last_category = [c for c in lm.calls if c[0][0].content == prompts.CATEGORY_SYSTEM][-1]
     assert last_category[0][-1].content == "Goal: pack art supplies.\nWhich objects is this goal about?"
     with pytest.raises(GiftError, match="category_from"):
@@ -201,9 +205,9 @@ def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects
 
 
 def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_questions_each_once():
-    from gift_kernels.alignment import score_alignment
+    from gift.core.alignment import score_alignment
 
-    lm = ScriptedLM(answer=lambda m, s: "art supplies" if "handled" in m[-1].content else "art things",
+    lm = ScriptedLM(answer=lambda m, s: category_json("art supplies" if "concerned" in m[-1].content else "art things"),
                     probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1,
                                           "crayons": 0.7, "toothbrush": 0.4, "apple": 0.05}))
     k = GiftProbKernel(lm=lm, combine="none")
@@ -213,8 +217,9 @@ def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_quest
     assert len(asked) == len(set(asked)) == k.calls  # no question twice
     # no goal-only category: K, the relevance and the leave-one-out scores share one scoring pass
     assert not any(a[-1].endswith("Which objects is this goal about?") for a in asked)
-    # 1 + 4 categories, 3 test and 4 training objects under the full category (rows of K(train, train))
+    # 1 + 4 categories (the full one, one without each training object), 3 test and 4 held-out training objects
     assert len(asked) == 1 + len(TRAIN) + len(TEST) + len(TRAIN)
+    assert sc.details["category"] == "art supplies"
 
 
 def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
@@ -232,16 +237,17 @@ def test_gift_prob_asks_the_semantic_axes_when_told_and_keeps_the_best_answer():
 
 def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_options():
     with pytest.raises(GiftError, match="log-probabilities.*scripted:scripted.*'gift' kernel"):
-        GiftProbKernel(lm=PlainLM(lambda m, s: "{}"), combine="none").relevance(TEST, TRAIN, ART)
+        GiftProbKernel(lm=PlainLM(lambda m, s: "{}"), combine="none").score(TEST, TRAIN, ART)
     with pytest.raises(GiftError, match="conditions on an intent"):
-        GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).relevance(TEST, TRAIN, None)
+        GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).score(TEST, TRAIN, None)
     for bad in ({"template": "nope"}, {"combine": "mean"}, {"weight": 2.0}, {"embed_reference": "x"},
                 {"standardize": "y"}):
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
-        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=lambda t: {"yes": .5, "no": .5}),
-                       combine="none").similarity(TEST, TRAIN, ART, relevant_train=("ghost",))
+        GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                     probs=lambda t: {"yes": .5, "no": .5}),
+                       combine="none").score(TEST, TRAIN, ART, relevant_train=("ghost",))
 
 
 def test_goal_text_turns_motivation_sentences_into_goal_clauses():
@@ -259,13 +265,17 @@ def test_category_answers_are_parsed_or_fall_back_to_the_goal_with_a_warning():
     assert prompts.parse_category("Answer: the valuables") == "valuables"
     for bad in ("", "   \n ", "these are all the objects that the goal could possibly be about here"):
         assert prompts.parse_category(bad) is None
-    lm = ScriptedLM(answer=lambda m, s: "", probs=lambda t: {"yes": 0.6, "no": 0.4})
+    # an answer that is no short noun phrase is asked again once, then the goal stands in
+    answers = iter(["", category_json("these are all the objects that the goal could possibly be about here")])
+    lm = ScriptedLM(answer=lambda m, s: next(answers), probs=lambda t: {"yes": 0.6, "no": 0.4})
     k = GiftProbKernel(lm=lm, combine="none")
     with pytest.warns(UserWarning, match="no object category.*pack art supplies"):
         k.log_odds(TEST[:1], ART)
     assert 'one of the things the goal "pack art supplies" is about?' in lm.calls[-1][0][1].content
-    k.log_odds(TEST[1:], ART)  # the goal's category is asked once
-    assert sum(c[0][0].content == prompts.CATEGORY_SYSTEM for c in lm.calls) == 1
+    k.log_odds(TEST[1:], ART)  # the goal's category is asked once (the first answer and one repair)
+    asked = [c[0] for c in lm.calls if c[0][0].content == prompts.CATEGORY_SYSTEM]
+    assert len(asked) == 2 and "no Python dictionary" in asked[1][-1].content
+    assert parse_category_answer({"category": "the Art supplies."}) == {"category": "Art supplies"}
 
 
 class TableKernel(SimilarityKernel):
@@ -292,19 +302,18 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
     rel = ("paintbrush", "sketchbook")
 
     def kernel(weighting):
-        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: "art supplies", probs=_probs_by_name(table)),
+        return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                            probs=_probs_by_name(table)),
                               weighting=weighting, language_kernel=TableKernel(vec))
 
     k = kernel("reliability")
-    r = k.relevance(TEST, TRAIN, ART, rel)
-    assert k.last_weights == {"lm": 0.0, "language": 1.0}
+    rs = k.score(TEST, TRAIN, ART, rel)
+    r = rs.relevance
+    assert rs.details["weights"] == {"lm": 0.0, "language": 1.0}
     assert r[0] > 0.5 > max(r[1:])  # crayons relevant, the brush for teeth and the fruit not
-    eq = kernel("equal")
-    eq.relevance(TEST, TRAIN, ART, rel)
-    assert eq.last_weights == {"lm": 0.5, "language": 0.5}
+    assert kernel("equal").score(TEST, TRAIN, ART, rel).details["weights"] == {"lm": 0.5, "language": 0.5}
     # no evidence (no irrelevant training object): the plain weights
-    k.relevance(TEST, TRAIN[:2], ART, rel)
-    assert k.last_weights == {"lm": 0.5, "language": 0.5}
+    assert k.score(TEST, TRAIN[:2], ART, rel).details["weights"] == {"lm": 0.5, "language": 0.5}
     with pytest.raises(GiftError, match="gift-prob: weighting"):
         GiftProbKernel(weighting="auc")
 
@@ -326,7 +335,7 @@ def test_gift_prob_on_the_embedded_model_ranks_and_aligns_art_supplies(embedded_
     train = suite.specs(spec.train_objects)
     intent = Intent(text=spec.text, source="ground-truth")
     k = gift.get_kernel("gift-prob", lm=embedded_lm)
-    r = k.relevance(test, train, intent, spec.relevant_train)
+    r = k.score(test, train, intent, spec.relevant_train).relevance
     assert r.shape == (4,) and np.all((r > 0) & (r < 1))
     assert min(r[:2]) > max(r[2:]), r  # the art supplies above the brush for teeth and the fruit
     lm_only = GiftProbKernel(lm=embedded_lm, combine="none").log_odds(test, intent)
@@ -343,15 +352,16 @@ def test_gift_prob_default_on_the_embedded_model_names_each_goals_category_and_r
 
     suite = load_suite(SUITE)
     k = gift.get_kernel("gift-prob", lm=embedded_lm)
-    aucs = {}
+    aucs, cats = {}, {}
     for spec in suite.intents:
         intent = Intent(text=spec.text, source="ground-truth")
         test, train = suite.specs(spec.test_objects), suite.specs(spec.train_objects)
-        r = k.relevance(test, train, intent, spec.relevant_train)
+        rs = k.score(test, train, intent, spec.relevant_train)
+        r, weights = rs.relevance, rs.details["weights"]
         assert r.shape == (len(test),) and np.all((r > 0) & (r < 1))
-        assert sum(k.last_weights.values()) == pytest.approx(1.0) and min(k.last_weights.values()) >= 0
+        assert sum(weights.values()) == pytest.approx(1.0) and min(weights.values()) >= 0
         aucs[spec.id] = roc_auc(r, [o.name in spec.relevant_test for o in test])
-    cats = {g: c.lower() for g, c in k.categories.items()}
+        cats[spec.text] = rs.details["category"].lower()
     assert len(cats) == len(aucs)  # the category each goal's test objects were asked about
     assert "electronic" in cats["keep the coffee away from electronics"]
     assert "art" in cats["pack art supplies"] and "sharp" in cats["put sharp tools away in the drawer"]
@@ -373,9 +383,9 @@ def test_gift_prob_on_the_embedded_model_recovers_the_category_of_an_object_boun
     intent = Intent(text="The person wanted to pick up the textbook and put it into the backpack.", source="inferred")
     auc = {}
     for source in ("goal", "goal+objects"):
-        k = GiftProbKernel(lm=embedded_lm, category_from=source)
-        auc[source] = roc_auc(k.relevance(test, train, intent, spec.relevant_train), labels)
-        cat = k.categories["pick up the textbook and put it into the backpack"].lower()
+        rs = GiftProbKernel(lm=embedded_lm, category_from=source).score(test, train, intent, spec.relevant_train)
+        auc[source] = roc_auc(rs.relevance, labels)
+        cat = rs.details["category"].lower()
         if source == "goal+objects":
             assert "backpack" not in cat and any(w in cat for w in ("reading", "book", "text")), cat
     # measured: 0.43 from the goal alone ("textbook, backpack"), 0.95 with the objects ("textbooks")
@@ -393,3 +403,70 @@ def test_gift_and_lm_no_intent_on_the_embedded_model_map_every_object_within_the
     assert K.shape == (2, 4) and np.all(np.isin(K, [0.0, 0.5, 1.0]))
     k0 = gift.get_kernel("lm-no-intent", lm=embedded_lm, samples=1)
     assert k0.similarity(test, TRAIN, ART).shape == (2, 4) and k0.calls == 1
+
+
+def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_chosen_one_asks_the_test_objects():
+    """candidates="all": the intent's text, its other motivations and the objects alone each name a category;
+    the one whose leave-one-out log-odds separate the demonstrated objects best names the test questions."""
+    def answer(messages, seed):
+        q = messages[-1].content
+        if q.startswith("Goal: pick up the sketchbook"):
+            return category_json("sketchbooks")
+        if q.startswith("Goal: tidy the table"):
+            return category_json("table things")
+        return category_json("art supplies")  # from the objects alone
+
+    yes = {("sketchbooks", "sketchbook"): 0.9, ("sketchbooks", "paintbrush"): 0.2,
+           ("table things", "banana"): 0.8, ("table things", "coffee mug"): 0.8,
+           ("art supplies", "paintbrush"): 0.9, ("art supplies", "sketchbook"): 0.8, ("art supplies", "crayons"): 0.85}
+
+    def probs(text):
+        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        p = yes.get((cat, name), 0.1)
+        return {"yes": p, "no": 1.0 - p}
+
+    lm = ScriptedLM(answer=answer, probs=probs)
+    intent = Intent(text="The person wanted to pick up the sketchbook.", source="inferred",
+                    motivations=(gift.Motivation("The person wanted to pick up the sketchbook."),
+                                 gift.Motivation("The person wanted to tidy the table.")))
+    k = GiftProbKernel(lm=lm, combine="none", candidates="all")
+    assert k.candidate_goals(intent, ("paintbrush", "sketchbook")) == [intent.text, "The person wanted to tidy the table.",
+                                                                        None]
+    rs = k.score(TEST, TRAIN, intent, ("paintbrush", "sketchbook"))
+    cands = {c["category"]: c for c in rs.details["candidates"]}
+    assert set(cands) == {"sketchbooks", "table things", "art supplies"}
+    assert cands["art supplies"]["chosen"] and cands["art supplies"]["auc"] == 1.0
+    assert cands["table things"]["auc"] == 0.0  # inverts the demonstrated objects
+    # the goal naming one member separates them too, by a smaller margin: the objects' category wins the tie
+    assert cands["sketchbooks"]["auc"] == 1.0 and cands["sketchbooks"]["margin"] < cands["art supplies"]["margin"]
+    assert rs.details["category"] == "art supplies" and rs.details["goal"] is None
+    assert np.allclose(rs.relevance, [0.85, 0.1, 0.1])
+    asked = [c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM]
+    test_questions = [q for q in asked if any(f"Is a {o.name} (" in q for o in TEST)]
+    assert len(test_questions) == len(TEST) and all("art supplies" in q for q in test_questions)
+    # the objects-only category question carries no goal line
+    objects_only = [c[0][-1].content for c in lm.calls
+                    if c[0][0].content == prompts.CATEGORY_SYSTEM and not c[0][-1].content.startswith("Goal:")]
+    assert objects_only and objects_only[0].endswith("Which kind of objects is the goal about?")
+    with pytest.raises(GiftError, match="candidates"):
+        GiftProbKernel(candidates="some")
+
+
+def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_suite():
+    """The category prompts' worked examples: none of their objects is in a suite catalog, and no word of
+    their goals and categories is a content word of a suite's goal (beyond function words and generic nouns
+    such as "supplies")."""
+    from gift.plugins.manager import get_manager
+
+    suites = [load_suite(s) for s in get_manager().suites()] + [load_suite(SUITE)]
+    objects = {o.lower() for s in suites for o in s.objects}
+    stop = {"the", "things", "thing", "and", "with", "from", "to", "of", "a", "an", "for", "anything", "away",
+            "put", "keep", "pack", "store", "get", "in", "on", "it", "that", "would", "if",
+            "supplies", "items", "objects", "goods"}  # generic nouns of a kind, not a kind themselves
+    goal_words = {w for s in suites for i in s.intents for w in re.findall(r"[a-z]+", i.text.lower())} - stop
+    examples = [(g, h + a, c) for g, h, a, c in prompts.CATEGORY_EXAMPLES_WITH_OBJECTS]
+    examples += [(g, (), c) for g, c in prompts.CATEGORY_EXAMPLES]
+    for goal, objs, category in examples:
+        assert not {o.lower() for o in objs} & objects, objs
+        words = set(re.findall(r"[a-z]+", f"{goal} {category}".lower())) - stop
+        assert not words & goal_words, (goal, words & goal_words)

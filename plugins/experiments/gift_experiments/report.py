@@ -1,22 +1,40 @@
-"""Figures (PNG) and ``report.md`` from a ``results.json`` dictionary of ``gift reproduce``.
+"""Figures (PNG), ``report.md`` and ``results.json`` of a study (``gift reproduce``, ``gift demo``), and the
+text tables of ``gift evaluate-alignment``.
 
-Results layout (every number of a run; figures read only this)::
+Results layout of a study (every number of a run; figures read only this; NaN is written as null)::
 
-    {"config": {...}, "manifest": {...}, "timing": {stage: seconds},
+    {"config": {...}, "manifest": {"git", "code_version", "lm": {"identity", "model_sha256", "usage"}, "suite",
+                                   "runs": [one record per run or resume]},
+     "timing": {stage: seconds},
+     "intents": {intent: {"text", "motivations", "axes", "source"}},
+     "relevant": {intent: {"names", "source", ...}},
+     "alignment": {intent: {kernel: {"thresholds": {thr: {"cut", "note", "mapping", "scores", "metrics"}},
+                                     "objects": {object: {"decision", "match"}}, "fallbacks", "details"}}},
      "sanity": {intent: {"inferred": [mean, se], "generic": [mean, se], "texts": [...]}},
      "rq1":    {intent: {kernel: {"mean": m, "se": s, "per_seed": [...]}}},
      "rq2":    {intent: {kernel: {threshold: {subset: {"f1", "fp", "fn", "fp_rate", "fn_rate", "auc", "n"}}}}},
      "scatter": {intent: {"anchor": name, "points": [{"object", "language", "vision", "relevant"}]}},
      "rq3":    {intent: {kernel: {"objects": [...], "relevant": [...], "mean": [...], "se": [...]}}}}
+
+``results.json`` is strict JSON (:func:`gift.core.serialization.write_json`): a number that is not defined
+(the AUC of a subset whose objects are all relevant or all irrelevant) is ``null``, and the means below skip it.
 """
 
 from __future__ import annotations
 
 import json
+import logging
+import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from gift.core.serialization import finite_values, write_json
+from gift.study.chain import REPORT_SUBSETS
+
+log = logging.getLogger("gift.report")
 
 KERNEL_ORDER = ("vision", "language", "lm-no-intent", "gift", "gift-prob")
 SUBSET_LABEL = {"R": "S_R", "lang": "S_lang", "vis": "S_vis", "unk": "S_unk", "all": "S_R ∪ S_conf"}
@@ -36,8 +54,15 @@ def _plt():
     return plt
 
 
+def _num(x: Any) -> float:
+    """A plotted number: ``null`` (None) and missing values are NaN (matplotlib leaves them out)."""
+    return float("nan") if x is None else float(x)
+
+
 def _grouped_bars(ax, groups: list[str], series: list[str], mean: np.ndarray, se: np.ndarray | None) -> None:
     """``mean``/``se``: ``[n_series, n_groups]``."""
+    mean = np.vectorize(_num, otypes=[float])(mean)
+    se = None if se is None else np.vectorize(_num, otypes=[float])(se)
     width = 0.8 / max(len(series), 1)
     x = np.arange(len(groups))
     for k, name in enumerate(series):
@@ -204,7 +229,7 @@ def win_rate_table(results: dict) -> str:
     for intent, per in rq1.items():
         rows.append(f"| {intent} | " + " | ".join(_fmt(per[k]["mean"], per[k]["se"]) if k in per else "–"
                                                   for k in kernels) + " |")
-    means = {k: [per[k]["mean"] for per in rq1.values() if k in per] for k in kernels}
+    means = {k: finite_values(per[k]["mean"] for per in rq1.values() if k in per) for k in kernels}
     rows.append("| **mean** | " + " | ".join(_fmt(float(np.mean(v))) if v else "–" for v in means.values()) + " |")
     return "\n".join(rows)
 
@@ -219,8 +244,8 @@ def f1_table(results: dict, threshold: str, subset: str = "all") -> str:
         cells = []
         for k in kernels:
             m = per.get(k, {}).get(threshold, {}).get(subset)
-            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and m.get("auc") is not None
-                         and not np.isnan(m["auc"]) else (f"{m['f1']:.2f}" if m else "–"))
+            cells.append(f"{m['f1']:.2f} (AUC {m['auc']:.2f})" if m and finite_values([m.get("auc")])
+                         else (f"{m['f1']:.2f}" if m else "–"))
         rows.append(f"| {intent} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
@@ -239,20 +264,50 @@ def headline_table(runs: dict[str, dict], threshold: str = "train-calibrated") -
     for k in kernels:
         cells = []
         for res in runs.values():
-            wr = [per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per]
-            f1 = [per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
-                  if threshold in per.get(k, {}) and "all" in per[k][threshold]]
+            wr = finite_values(per[k]["mean"] for per in (res.get("rq1") or {}).values() if k in per)
+            f1 = finite_values(per[k][threshold]["all"]["f1"] for per in (res.get("rq2") or {}).values()
+                               if threshold in per.get(k, {}) and "all" in per[k][threshold])
             se = float(np.std(wr, ddof=1) / np.sqrt(len(wr))) if len(wr) > 1 else None
             cells += [_fmt(float(np.mean(wr)), se) if wr else "–", _fmt(float(np.mean(f1))) if f1 else "–"]
         rows.append(f"| {k} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
 
+def coverage(results: Mapping[str, Any]) -> set[tuple[str, str, str]]:
+    """``(section, intent, kernel)`` entries of RQ1 and RQ2 a results dictionary holds."""
+    out = set()
+    for section in ("rq1", "rq2"):
+        for intent, per in (results.get(section) or {}).items():
+            out.update((section, intent, k) for k in per)
+    return out
+
+
+def save_results(results: dict, out: Path) -> Path:
+    """Write ``out/results.json`` atomically as strict JSON (NaN, e.g. the AUC of a one-class subset, is
+    ``null``). A results file that holds entries the new one lacks is never lost: it is kept as
+    ``results.prev.json`` and a warning names what is missing."""
+    path = out / "results.json"
+    if path.exists():
+        try:
+            old = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            old = None
+        missing = sorted(coverage(old) - coverage(results)) if isinstance(old, dict) else []
+        if missing:
+            keep = out / "results.prev.json"
+            path.replace(keep)
+            shown = ", ".join("/".join(m) for m in missing[:8]) + (" ..." if len(missing) > 8 else "")
+            log.warning("%s held results the new run does not have (%s); the old file is kept as %s",
+                        path, shown, keep)
+    write_json(path, results)
+    return path
+
+
 def write_report(results: dict, out: Path, command: str = "") -> Path:
-    """Write ``out/report.md`` (tables + figures inline) and ``out/results.json``."""
+    """Write ``out/report.md`` (tables + figures inline) and ``out/results.json`` (:func:`save_results`)."""
     out.mkdir(parents=True, exist_ok=True)
     figures = make_figures(results, out)
-    (out / "results.json").write_text(json.dumps(results, indent=2, default=json_default))
+    save_results(results, out)
     lines = ["# gift reproduce report", ""]
     if command:
         lines += ["Made by:", "", f"```\n{command}\n```", ""]
@@ -262,6 +317,13 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
     if results.get("intents"):
         lines += ["## Intents the kernels were conditioned on", "", "| intent | source | text |", "|---|---|---|"]
         lines += [f"| {i} | {d.get('source', '')} | {d.get('text', '')} |" for i, d in results["intents"].items()]
+        lines.append("")
+    if results.get("relevant"):
+        lines += ["## Relevant training objects", "",
+                  "Inferred from the demonstrations in inferred mode (the suite's labels are never read there); "
+                  "the suite's labels in ground-truth mode.", "", "| intent | source | relevant |", "|---|---|---|"]
+        lines += [f"| {i} | {d.get('source', '')} | {', '.join(d.get('names', []))} |"
+                  for i, d in results["relevant"].items()]
         lines.append("")
     if results.get("sanity"):
         lines += ["## Sanity check: inferred intents", "",
@@ -288,18 +350,86 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
                   "unmapped aligns to *distractor*); first line of each, every detail is in `results.json`:", ""]
         lines += [f"- {str(e).splitlines()[0][:300]}" for e in results["errors"]] + [""]
     if results.get("timing"):
-        lines += ["## Time per stage (s)", "", "| stage | seconds |", "|---|---|"]
+        lines += ["## Time per stage (s), this run", "", "| stage | seconds |", "|---|---|"]
         lines += [f"| {k} | {v:.1f} |" for k, v in results["timing"].items()] + [""]
+    runs = (results.get("manifest") or {}).get("runs") or []
+    if runs:
+        lines += ["## Runs that made these results", "",
+                  "| started | seconds | commit | LM | model sha256 |", "|---|---|---|---|---|"]
+        for r in runs:
+            git = r.get("git") or {}
+            commit = (git.get("commit") or "")[:10] + (" (dirty)" if git.get("dirty") else "")
+            lm = r.get("lm") or {}
+            lines.append(f"| {r.get('started', '')} | {r.get('seconds', '')} | {commit or '–'} | "
+                         f"{lm.get('identity', '–')} | {(lm.get('model_sha256') or '–')[:12]} |")
+        lines.append("")
     lines += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures] + [""]
     path = out / "report.md"
-    path.write_text("\n".join(lines))
+    path.write_text("\n".join(lines), encoding="utf-8")
     return path
 
 
-def json_default(o: Any) -> Any:
-    """``json.dumps(default=...)`` for numpy scalars and arrays."""
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+# ----------------------------------------------------------------------------- text report
+
+
+def alignment_report(result: Mapping[str, Any], *, per_intent: bool = True, detailed: bool = False) -> str:
+    """Markdown tables: per kernel x threshold on the union (P, R, F1, AUC, FP, FN) with F1 and FP/FN per
+    subset; then F1 per intent; ``detailed`` adds every metric per subset."""
+    thresholds = result["thresholds"]
+    subs = [s for s in REPORT_SUBSETS if s != "all"]
+    lines = [f"Suite `{result['suite']}`, intent source `{result['intent_source']}`. Union = every test object, "
+             f"pooled over intents; AUC = mean over intents.", ""]
+    lines += ["| kernel | threshold | P | R | F1 | AUC | FP | FN | " + " | ".join(f"F1 {_subset_label(s)}" for s in subs)
+              + " | " + " | ".join(f"FP/FN {_subset_label(s)}" for s in subs) + " |",
+              "|---" * (8 + 2 * len(subs)) + "|"]
+    for kname, k in result["kernels"].items():
+        if not k["overall"]:
+            lines.append(f"| {kname} | - | error: {_first_error(k)} |" + " |" * (6 + 2 * len(subs)))
+            continue
+        for thr in thresholds:
+            o = k["overall"].get(thr, {})
+            u = o.get("all")
+            if u is None:
+                continue
+            f1s = " | ".join(f"{o[s]['f1']:.2f}" if s in o else "-" for s in subs)
+            fpfn = " | ".join(f"{o[s]['fp']}/{o[s]['fn']}" if s in o else "-" for s in subs)
+            lines.append(f"| {kname} | {thr} | {u['precision']:.2f} | {u['recall']:.2f} | **{u['f1']:.2f}** | "
+                         f"{_f(u['auc_mean_intent'])} | {u['fp']} | {u['fn']} | {f1s} | {fpfn} |")
+    if detailed:
+        lines += ["", "| kernel | threshold | subset | n | precision | recall | F1 | AUC (mean/intent) | FP | FN |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for kname, k in result["kernels"].items():
+            for thr in thresholds:
+                for sub in REPORT_SUBSETS:
+                    m = k["overall"].get(thr, {}).get(sub)
+                    if m is None:
+                        continue
+                    lines.append(f"| {kname} | {thr} | {_subset_label(sub)} | {m['n']} | {m['precision']:.2f} | "
+                                 f"{m['recall']:.2f} | {m['f1']:.2f} | {_f(m['auc_mean_intent'])} | {m['fp']} | "
+                                 f"{m['fn']} |")
+    if per_intent:
+        lines += ["", "Per intent (all its test objects):", "",
+                  "| kernel | intent | " + " | ".join(f"F1 {t}" for t in thresholds) + " | AUC |",
+                  "|---|---|" + "---|" * (len(thresholds) + 1)]
+        for kname, k in result["kernels"].items():
+            for iid, r in k["intents"].items():
+                m = r["metrics"]
+                f1s = " | ".join(f"{m[t]['all']['f1']:.2f}" for t in thresholds)
+                lines.append(f"| {kname} | {iid} | {f1s} | {_f(m[thresholds[0]]['all']['auc'])} |")
+    errs = [(k, i, e) for k, d in result["kernels"].items() for i, e in d["errors"].items()]
+    if errs:
+        lines += ["", "Errors:"]
+        lines += [f"- {k} / {i}: {e.splitlines()[0]}" for k, i, e in errs]
+    return "\n".join(lines)
+
+
+def _first_error(k: Mapping[str, Any]) -> str:
+    return next(iter(k["errors"].values()), "no result").splitlines()[0].replace("|", "/")
+
+
+def _subset_label(sub: str) -> str:
+    return "union" if sub == "all" else f"S_{sub}"
+
+
+def _f(x: float) -> str:
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.2f}"

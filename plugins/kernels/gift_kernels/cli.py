@@ -1,20 +1,16 @@
-"""CLI subcommands of gift_kernels: ``gift align`` and ``gift evaluate-alignment``.
-
-(``gift infer-intent`` lives in its own functions below those, owned by the intent-estimation part.)
-"""
+"""``gift align``: align test objects to training objects with one kernel (``gift infer-intent``: intent_cli)."""
 
 from __future__ import annotations
 
 import argparse
-import json
-import sys
-from collections.abc import Sequence
-from pathlib import Path
+import difflib
+import logging
+from collections.abc import Mapping, Sequence
 
+from gift.core import serialization
+from gift.core.alignment import THRESHOLDS, score_alignment
 from gift.core.data import DISTRACTOR, Intent, ObjectSpec
 from gift.core.errors import GiftError
-from gift.core.executor import add_executor_argument, executor_from_args
-from gift_kernels.alignment import THRESHOLDS, score_alignment
 
 # ----------------------------------------------------------------------------- gift align
 
@@ -30,33 +26,70 @@ def configure_align(p: argparse.ArgumentParser) -> None:
                    help="non-oracle (default) | train-calibrated | a number in [0, 1]")
     p.add_argument("--suite", default=None, help="look object descriptions/appearances up in this suite "
                                                  "(default: every registered suite's catalog)")
+    p.add_argument("--allow-unknown", action="store_true",
+                   help="accept object names that no catalog has (they get no description and the default "
+                        "appearance, a grey 8 cm cube; the output lists them). Default: an error")
     p.add_argument("--lm", default=None, help="LM backend for LM kernels (default: the embedded model)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
 
-def catalog_objects(names: Sequence[str], suite: str | None = None) -> tuple[ObjectSpec, ...]:
-    """ObjectSpecs for names: from ``suite``'s catalog, else any registered suite's; unknown names get a bare spec."""
+def lookup_objects(names: Sequence[str], suite: str | None = None
+                   ) -> tuple[tuple[ObjectSpec, ...], list[str], dict[str, Mapping[str, ObjectSpec]]]:
+    """``(specs, missing, catalogs)``: the catalog entry of each name (from ``suite``'s catalog, else the first
+    registered suite's that has it), the names no catalog has (given a bare spec), and the catalogs searched."""
     from gift.core.suite import load_suite
     from gift.plugins.manager import get_manager
 
-    catalogs = []
+    catalogs: dict[str, Mapping[str, ObjectSpec]] = {}
     if suite is not None:
-        catalogs.append(load_suite(suite).objects)
+        loaded = load_suite(suite)
+        catalogs[loaded.path or suite] = loaded.objects
     else:
         for name in sorted(get_manager().suites()):
             try:
-                catalogs.append(load_suite(name).objects)
+                catalogs[name] = load_suite(name).objects
             except GiftError:
                 continue
-    out = []
+    specs, missing = [], []
     for n in names:
-        found = next((c[n] for c in catalogs if n in c), None)
-        out.append(found if found is not None else ObjectSpec(name=n))
-    return tuple(out)
+        found = next((c[n] for c in catalogs.values() if n in c), None)
+        if found is None:
+            missing.append(n)
+            found = ObjectSpec(name=n)
+        specs.append(found)
+    return tuple(specs), missing, catalogs
+
+
+def catalog_objects(names: Sequence[str], suite: str | None = None, *, allow_unknown: bool = False
+                    ) -> tuple[ObjectSpec, ...]:
+    """ObjectSpecs for names (see :func:`lookup_objects`).
+
+    A name that no catalog has is a :class:`GiftError` naming it, with close matches: a bare name would
+    silently be a grey cube without a description. ``allow_unknown=True`` gives it that bare spec instead.
+    """
+    specs, missing, catalogs = lookup_objects(names, suite)
+    if missing and not allow_unknown:
+        raise unknown_objects_error(missing, catalogs, suite)
+    return specs
+
+
+def unknown_objects_error(missing: Sequence[str], catalogs: Mapping[str, Mapping[str, ObjectSpec]],
+                          suite: str | None) -> GiftError:
+    known = sorted({k for c in catalogs.values() for k in c})
+    hints = []
+    for n in missing:
+        close = difflib.get_close_matches(n, known, n=3)
+        hints.append(f"{n!r} (did you mean {', '.join(map(repr, close))}?)" if close else repr(n))
+    where = (f"the catalog of suite {next(iter(catalogs))}" if suite is not None else
+             f"the catalog of any registered suite ({', '.join(catalogs) or 'none'})")
+    many = len(missing) > 1
+    return GiftError(f"unknown object{'s' if many else ''} {', '.join(hints)}: not in {where}. Add "
+                     f"{'them' if many else 'it'} to a suite file and pass --suite FILE, or pass --allow-unknown "
+                     f"to use bare names (no description, the default appearance: a grey 8 cm cube)")
 
 
 def run_align(args: argparse.Namespace) -> int:
-    from gift_kernels.evaluation import _create, parse_kernel_spec
+    from gift.study.components import build, parse_spec
 
     clash = sorted(set(args.train) & set(args.test))
     if clash:
@@ -71,10 +104,20 @@ def run_align(args: argparse.Namespace) -> int:
         except ValueError:
             raise GiftError(f"--threshold must be one of non-oracle, train-calibrated or a number, "
                             f"got {args.threshold!r}") from None
-    name, options = parse_kernel_spec(args.kernel)
-    kernel = _create("kernel", name, args.lm, **options)
-    train = catalog_objects(args.train, args.suite)
-    test = catalog_objects(args.test, args.suite)
+    stray = sorted(set(args.relevant) - set(args.train))
+    if stray:
+        raise GiftError(f"--relevant {stray}: not among the --train objects {list(args.train)}")
+    train, missing_train, catalogs = lookup_objects(args.train, args.suite)
+    test, missing_test, _ = lookup_objects(args.test, args.suite)
+    unknown = missing_train + missing_test
+    if unknown and not args.allow_unknown:
+        raise unknown_objects_error(unknown, catalogs, args.suite)
+    if unknown:
+        logging.getLogger("gift").warning(
+            "gift align: warning: %d object(s) in no catalog, aligned as bare names without a description and "
+            "with the default appearance (a grey 8 cm cube): %s", len(unknown), ", ".join(unknown))
+    name, _ = parse_spec(args.kernel)
+    kernel = build("kernel", args.kernel, lm=args.lm)
     intent = Intent(text=args.intent, source="given") if args.intent else None
     if getattr(kernel, "uses_intent", False) and intent is None:
         raise GiftError(f"kernel {name!r} reads the intent: pass --intent TEXT")
@@ -92,10 +135,12 @@ def run_align(args: argparse.Namespace) -> int:
                      "relevant": (target != DISTRACTOR and target in rel) if rel else None})
     out = {"kernel": args.kernel, "intent": args.intent, "threshold": cut, "threshold_rule": note,
            "error_bound_per_state": alignment.error_bound(), "alignment": rows,
+           "unknown_objects": {"names": unknown, "note": "in no catalog: no description, default appearance "
+                                                         "(grey 8 cm cube)"} if unknown else None,
            "similarity": {"test": list(scores.test), "train": list(scores.train),
                           "K": [[round(float(v), 6) for v in row] for row in scores.K]}}
     if args.json:
-        print(json.dumps(out, indent=2))
+        print(serialization.dumps(out, indent=2))
         return 0
     print(f"kernel {args.kernel}, threshold {cut:.3f} ({note})")
     width = max(len(o.name) for o in test)
@@ -104,53 +149,3 @@ def run_align(args: argparse.Namespace) -> int:
         print(f"  {r['object']:<{width}} -> {r['target']:<20} K={r['score']:.3f}{flag}")
     print(f"alignment error bound per state (L=1): {out['error_bound_per_state']:.3f}")
     return 0
-
-
-# ----------------------------------------------------------------------------- gift evaluate-alignment
-
-
-def configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--suite", required=True, help="registered suite name or a suite YAML file")
-    p.add_argument("--kernels", required=True,
-                   help="comma-separated kernels, each a registered name optionally with :key=value options, "
-                        "e.g. language,language:use_descriptions=true,vision")
-    p.add_argument("--intent-source", default="ground-truth", choices=("ground-truth", "inferred"),
-                   help="ground-truth intent text, or inferred by the GIFT front half (Drake demos + LM)")
-    p.add_argument("--threshold", default=",".join(THRESHOLDS),
-                   help=f"comma-separated threshold strategies (default: all of {','.join(THRESHOLDS)})")
-    p.add_argument("--intents", default=None, help="comma-separated intent ids (default: all)")
-    p.add_argument("--lm", default=None, help="LM backend for LM kernels and intent inference")
-    p.add_argument("--json", action="store_true", help="print the full result as JSON")
-    p.add_argument("--out", default=None, metavar="FILE", help="also write the full JSON result to FILE")
-    p.add_argument("--detailed", action="store_true", help="also print every metric per subset")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
-    add_executor_argument(p)  # one item per (kernel, intent); serial checkpoints --out after every item
-
-
-def _progress(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
-def run_evaluate_alignment(args: argparse.Namespace) -> int:
-    from gift_kernels.evaluation import evaluate_alignment, format_report
-
-    kernels = [k.strip() for k in args.kernels.split(",") if k.strip()]
-    if not kernels:
-        raise GiftError("--kernels is empty")
-    thresholds = [t.strip() for t in args.threshold.split(",") if t.strip()]
-    intents = [i.strip() for i in args.intents.split(",")] if args.intents else None
-    progress = None if args.quiet else _progress
-
-    def write(result: dict) -> None:  # serial: after every kernel x intent, so an interrupted run keeps its numbers
-        tmp = Path(str(args.out) + ".tmp")
-        tmp.write_text(json.dumps(result, indent=2), encoding="utf-8")
-        tmp.replace(args.out)
-
-    with executor_from_args(args) as executor:
-        result = evaluate_alignment(args.suite, kernels, thresholds=thresholds, intent_source=args.intent_source,
-                                    lm=args.lm, intents=intents, progress=progress,
-                                    checkpoint=write if args.out else None, executor=executor,
-                                    echo=progress is not None and not executor.in_process and executor.live_stderr)
-    print(json.dumps(result, indent=2) if args.json else format_report(result, detailed=args.detailed))
-    failed = [k for k, d in result["kernels"].items() if d["errors"]]
-    return 1 if len(failed) == len(kernels) else 0

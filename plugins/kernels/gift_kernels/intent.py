@@ -4,8 +4,10 @@ Call 1 shows the LM demonstration pairs as textual feature traces (default vs pr
 descriptions and the features of other scenes, and asks for three ranked motivations, each with the
 features it concerns (only features that exist), plus semantic similarities. Call 2 turns the
 motivations into semantic axes: short yes/no questions with the objects (that exist) answering yes.
-Both answers go through ``gift_llm.structured.ask_dict`` with a validator, so an unknown feature or
-object triggers a repair request naming it.
+Both answers go through ``gift_llm.structured.ask_dict`` with the JSON schema of
+:mod:`gift_kernels.schemas` (on llama.cpp a grammar: only known feature and object names can be written)
+and a validator, so on a backend without grammar an unknown feature or object triggers a repair request
+naming it.
 
 To fit a 1.5B model with a 4k context, each trace shows only the features whose preferred and default
 values differ (at most ``max_features`` per pair, largest difference first), at about ``max_steps``
@@ -23,11 +25,18 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+import gift
+
 from gift.core.data import DemonstrationPair, Intent, Motivation, SemanticAxis
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import IntentEstimator, LMBackend
-from gift_kernels import prompts
-from gift_kernels.lm_kernels import resolve_lm
+from gift_kernels import prompts, schemas
+
+
+#: Answer budgets in tokens. Call 1's prompt is held to ``max_prompt_chars`` (8000 by default, about
+#: 3200 tokens), so that prompt and answer fit the embedded model's 4096-token context.
+CALL1_MAX_TOKENS = 640
+CALL2_MAX_TOKENS = 768
 
 
 def _norm(s: Any) -> str:
@@ -72,7 +81,7 @@ def parse_motivations(answer: Mapping[str, Any], features: Sequence[str]) -> tup
     raw = answer.get("semantic_similarities", [])
     try:
         for q, feats in _entries(raw, "features"):
-            sims.append(SemanticAxis(question=q, objects=tuple(known[_norm(f)] for f in feats if _norm(f) in known)))
+            sims.append(SemanticAxis(question=q, objects=_canonical(feats, known, [])))  # unknown names dropped
     except ValidationError:
         sims = []  # optional part: a malformed one is dropped, the motivations are kept
     return mots[:3], sims
@@ -114,7 +123,9 @@ class LMContrastiveIntentEstimator(IntentEstimator):
 
     def __init__(self, lm: LMBackend | str | None = None, max_steps: int = 8, max_features: int = 6,
                  temperature: float = 0.0, seed: int = 0, max_repairs: int = 2, axes: bool = True,
-                 max_prompt_chars: int = 8000) -> None:
+                 max_prompt_chars: int = 8000, constrained: bool = True) -> None:
+        from gift_llm.structured import AskStats
+
         if max_steps < 2 or max_features < 1:
             raise GiftError(f"lm-contrastive: max_steps must be >= 2 and max_features >= 1, got {max_steps}, "
                             f"{max_features}")
@@ -123,12 +134,15 @@ class LMContrastiveIntentEstimator(IntentEstimator):
         self.max_prompt_chars = int(max_prompt_chars)
         self.temperature, self.seed, self.max_repairs, self.with_axes = float(temperature), int(seed), \
             int(max_repairs), bool(axes)
+        #: Send the JSON schemas of Calls 1 and 2 (``gift_kernels.schemas``) with every request.
+        self.constrained = bool(constrained)
         self.calls = 0
+        self.stats = AskStats()  # answers read, repair requests and failures of Calls 1 and 2
 
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            self._lm = resolve_lm(self._lm_spec)
+            self._lm = gift.resolve_lm(self._lm_spec)
         return self._lm
 
     # ------------------------------------------------------------------ prompt material
@@ -179,7 +193,8 @@ class LMContrastiveIntentEstimator(IntentEstimator):
         self.calls += 1
         answer = ask_dict(self.lm, messages, validate=lambda d: parse_motivations(d, features) and None,
                           max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
-                          required_keys=("motivations",))
+                          required_keys=("motivations",), max_tokens=CALL1_MAX_TOKENS, stats=self.stats,
+                          json_schema=schemas.intent_schema(features) if self.constrained else None)
         return parse_motivations(answer, features)
 
     def semantic_axes(self, motivations: Sequence[Motivation], objects: Sequence[str]) -> list[SemanticAxis]:
@@ -193,7 +208,8 @@ class LMContrastiveIntentEstimator(IntentEstimator):
         try:
             answer = ask_dict(self.lm, messages, validate=lambda d: parse_axes(d, objects) and None,
                               max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed,
-                              required_keys=("axes",))
+                              required_keys=("axes",), max_tokens=CALL2_MAX_TOKENS, stats=self.stats,
+                              json_schema=schemas.axes_schema(objects) if self.constrained else None)
         except LMAnswerError as e:
             # the axes refine the intent: keep the last answer's axes without the names that do not exist;
             # with none left, the intent keeps Call 1's similarities (see estimate)

@@ -90,3 +90,10 @@ class LanguageKernel(SimilarityKernel):
             return np.zeros((len(test), len(train)))
         emb = embed_texts([object_text(o, self.use_descriptions) for o in (*test, *train)])
         return cosine_to_unit(cosine(emb[:len(test)], emb[len(test):]))
+
+    @staticmethod
+    def text_cosine(texts: Sequence[str], reference: str) -> np.ndarray:
+        """MiniLM cosine in [-1, 1] of each of ``texts`` with ``reference``: ``[n]`` (e.g. an inferred intent
+        against the true one: the paper's sanity check)."""
+        emb = embed_texts(list(texts) + [reference])  # unit-norm rows
+        return emb[:-1] @ emb[-1]

@@ -33,24 +33,15 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
+import gift
+
+from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec, RelevanceScores
 from gift.core.errors import GiftError, LMAnswerError, ValidationError
-from gift.core.interfaces import LMBackend, SimilarityKernel
-from gift_kernels import prompts
+from gift.core.interfaces import LMBackend, RelevanceKernel, SimilarityKernel
+from gift_kernels import prompts, schemas
 
 #: Log-odds are clipped to ±LOGIT_CLIP (probabilities of exactly 0 or 1 would be infinite).
 LOGIT_CLIP = 12.0
-
-
-def resolve_lm(lm: LMBackend | str | None) -> LMBackend:
-    """An LM backend instance: ``lm`` itself, or ``gift_llm.resolve_lm(name_or_None)`` (the embedded default)."""
-    if isinstance(lm, LMBackend) or (lm is not None and not isinstance(lm, str) and hasattr(lm, "complete")):
-        return lm
-    try:
-        import gift_llm
-    except ImportError as e:  # pragma: no cover - gift-llm is a dependency of gift-kernels
-        raise GiftError("the LM kernels need the gift-llm plugin (pip install -e plugins/llm)") from e
-    return gift_llm.resolve_lm(lm)
 
 
 def _object_names(objs: Sequence[ObjectSpec | str]) -> list[str]:
@@ -83,6 +74,13 @@ def _valid_part(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[
             continue
         out[t] = target
     return out, unknown_targets
+
+
+def mapping_max_tokens(test: Sequence[str], train: Sequence[str]) -> int:
+    """Token budget of one Call-3 answer: every test object with the longest target, at about 3
+    characters per token, plus room; at least 512."""
+    longest = max([len(DISTRACTOR), *map(len, train)])
+    return max(512, 64 + sum(len(t) + longest + 8 for t in test) // 3)
 
 
 def parse_mapping(answer: Mapping[str, Any], test: Sequence[str], train: Sequence[str]) -> dict[str, str]:
@@ -133,19 +131,24 @@ class MappingKernel(SimilarityKernel):
     uses_intent: ClassVar[bool] = True
 
     def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
-                 seed: int = 0, use_intent: bool = True, max_repairs: int = 2) -> None:
+                 seed: int = 0, use_intent: bool = True, max_repairs: int = 2, constrained: bool = True) -> None:
+        from gift_llm.structured import AskStats
+
         if not isinstance(samples, int) or samples < 1:
             raise GiftError(f"{self.name} kernel: samples must be a positive integer, got {samples!r}")
         self._lm_spec, self._lm = lm, None
         self.samples, self.temperature, self.seed = samples, float(temperature), int(seed)
         self.use_intent, self.max_repairs = bool(use_intent), int(max_repairs)
+        #: Send Call 3's JSON schema (``schemas.mapping_schema``) with every request (False: free text).
+        self.constrained = bool(constrained)
         self.calls = 0  # LM calls made (including those served from the LM cache)
         self.fallbacks: list[str] = []  # samples completed by default (see _sample)
+        self.stats = AskStats()  # answers read, repair requests, samples still invalid after the repairs
 
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            self._lm = resolve_lm(self._lm_spec)
+            self._lm = gift.resolve_lm(self._lm_spec)
         return self._lm
 
     def _sample(self, test: list[str], train: list[str], intent: Intent | None, k: int) -> dict[str, str]:
@@ -155,10 +158,12 @@ class MappingKernel(SimilarityKernel):
         t_order = [test[i] for i in rng.permutation(len(test))]
         s_order = [train[i] for i in rng.permutation(len(train))]
         messages = prompts.mapping_messages(t_order, s_order, intent)
+        schema = schemas.mapping_schema(t_order, s_order) if self.constrained else None
         self.calls += 1
         try:
             answer = ask_dict(self.lm, messages, validate=lambda d: parse_mapping(d, test, train),
-                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k)
+                              max_repairs=self.max_repairs, temperature=self.temperature, seed=self.seed + k,
+                              max_tokens=mapping_max_tokens(test, train), json_schema=schema, stats=self.stats)
         except LMAnswerError as e:
             # still incomplete after the repairs: keep the valid part of the last answer; an object it
             # leaves unmapped (or maps to an unknown name) aligns to nothing, i.e. distractor. An answer
@@ -204,9 +209,9 @@ class NoIntentMappingKernel(MappingKernel):
     uses_intent: ClassVar[bool] = False
 
     def __init__(self, lm: LMBackend | str | None = None, samples: int = 10, temperature: float = 0.7,
-                 seed: int = 0, max_repairs: int = 2) -> None:
+                 seed: int = 0, max_repairs: int = 2, constrained: bool = True) -> None:
         super().__init__(lm=lm, samples=samples, temperature=temperature, seed=seed, use_intent=False,
-                         max_repairs=max_repairs)
+                         max_repairs=max_repairs, constrained=constrained)
 
 
 # ============================================================================= gift-prob
@@ -227,6 +232,17 @@ EMBED_REFERENCE = ("relevant", "contrastive")
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
+CANDIDATES = ("text", "all")
+
+
+def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
+    """Validate a category answer ``{"category": <noun phrase>}``: the phrase cleaned by
+    :func:`gift_kernels.prompts.parse_category`; :class:`ValidationError` when it is no short noun phrase."""
+    value = answer.get("category")
+    cat = prompts.parse_category(value) if isinstance(value, str) else None
+    if cat is None:
+        raise ValidationError(f"'category' must be a short plural noun phrase (at most 8 words), got {value!r}")
+    return {"category": cat}
 
 
 def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
@@ -241,7 +257,7 @@ def separation_weight(train_scores: np.ndarray, relevant: np.ndarray) -> float:
     return float("nan") if math.isnan(auc) else max(auc - 0.5, 0.0)
 
 
-class GiftProbKernel(SimilarityKernel):
+class GiftProbKernel(RelevanceKernel):
     """Continuous GIFT kernel: P(yes) that an object is what the goal is about, as log-odds.
 
     Default recipe (``docs/results/gift_prob.md``): the LM names the kind of object the goal is about
@@ -270,7 +286,8 @@ class GiftProbKernel(SimilarityKernel):
     def __init__(self, lm: LMBackend | str | None = None, template: str = "category", use_descriptions: bool = True,
                  axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
-                 category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None) -> None:
+                 category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
+                 constrained: bool = True, candidates: str = "text", candidate_terms: bool = False) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -285,15 +302,21 @@ class GiftProbKernel(SimilarityKernel):
             raise GiftError(f"gift-prob: category_from must be one of {CATEGORY_FROM}, got {category_from!r}")
         if not 0.0 <= float(weight) <= 1.0:
             raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
+        if candidates not in CANDIDATES:
+            raise GiftError(f"gift-prob: candidates must be one of {CANDIDATES}, got {candidates!r}")
+        #: ``"text"``: the intent's text names the category; ``"all"``: every motivation and the objects alone
+        #: are candidates, and the training objects verify them (:meth:`candidate_goals`).
+        self.candidates = candidates
+        #: Also ask every candidate's category about the test objects and report it (for studies; costs LM calls).
+        self.candidate_terms = bool(candidate_terms)
         self._lm_spec, self._lm = lm, None
         self.template, self.use_descriptions, self.axes = template, bool(use_descriptions), bool(axes)
         self.combine, self.embed_reference, self.weight = combine, embed_reference, float(weight)
         self.standardize, self.weighting, self.category_from = standardize, weighting, category_from
         self._category_memo: dict[tuple, str] = {}
+        #: Send the category call's JSON schema (``schemas.category_schema``) with each request.
+        self.constrained = bool(constrained)
         self._language = language_kernel
-        self.categories: dict[str, str] = {}  # goal -> the category its test objects were last asked about
-        self.last_weights: dict[str, float] = {}  # term -> weight used by the last scores() call
-        self._last: tuple[tuple, np.ndarray] | None = None  # (train key, LOO train scores) of the last call
         self._memo: dict[tuple, float] = {}
         self._lock = threading.Lock()
         self.calls = 0  # distinct yes/no questions sent to the LM
@@ -307,7 +330,7 @@ class GiftProbKernel(SimilarityKernel):
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
-            lm = resolve_lm(self._lm_spec)
+            lm = gift.resolve_lm(self._lm_spec)
             if not getattr(lm, "supports_choice_probabilities", False):
                 raise GiftError(
                     f"gift-prob needs token log-probabilities, which the LM backend {lm.identity()!r} does not "
@@ -344,29 +367,39 @@ class GiftProbKernel(SimilarityKernel):
             self._memo[key] = lo
         return lo
 
-    def category(self, intent: Intent, handled: Sequence[str] = (), left_alone: Sequence[str] = ()) -> str:
-        """The kind of object the intent's goal is about ("art supplies"), asked once per question (greedy).
+    def category(self, intent: Intent | str | None, handled: Sequence[str] = (), left_alone: Sequence[str] = ()
+                 ) -> str:
+        """The kind of object a goal is about ("art supplies"), asked once per question (greedy).
 
-        With ``category_from="goal+objects"`` and at least one ``handled`` training object (one the
+        ``intent``: an Intent, its goal text, or None (no goal: name the kind from the objects alone). With
+        ``category_from="goal+objects"`` and at least one ``handled`` training object (one the
         demonstrations treat as part of the goal; ``left_alone``: the others) the LM names the kind
-        from the goal and those objects; else from the goal alone. An answer that is not a short noun
-        phrase falls back, with a warning, to the goal itself.
+        from the goal (if any) and those objects; else from the goal alone. An answer that is not a short
+        noun phrase falls back, with a warning, to the goal itself.
         """
-        goal = prompts.goal_text(intent.text)
-        use_objects = self.category_from == "goal+objects" and len(handled) > 0
+        text = intent.text if isinstance(intent, Intent) else intent
+        goal = prompts.goal_text(text) if text else None
+        use_objects = (self.category_from == "goal+objects" or goal is None) and len(handled) > 0
+        if goal is None and not use_objects:
+            raise GiftError("gift-prob: naming a category without a goal needs at least one handled object")
         key = (goal, tuple(handled), tuple(left_alone)) if use_objects else (goal,)
         with self._lock:
             if key in self._category_memo:
                 return self._category_memo[key]
+        from gift_llm.structured import ask_dict
+
         msgs = (prompts.category_from_objects_messages(goal, handled, left_alone) if use_objects
                 else prompts.category_messages(goal))
-        answer = self.lm.complete(msgs, temperature=0.0, max_tokens=24, stop=["\n"]).text
         self.calls += 1
-        cat = prompts.parse_category(answer)
-        if cat is None:
-            warnings.warn(f"gift-prob: the LM named no object category for the goal {goal!r} (answer "
-                          f"{answer[:80]!r}); asking about the goal itself", stacklevel=2)
-            cat = prompts.fallback_category(goal)
+        try:
+            cat = ask_dict(self.lm, msgs, validate=parse_category_answer, max_repairs=1, temperature=0.0,
+                           max_tokens=32, json_schema=schemas.category_schema() if self.constrained else None,
+                           required_keys=("category",))["category"]
+        except LMAnswerError as e:
+            shown = goal or f"the objects {', '.join(handled)}"
+            warnings.warn(f"gift-prob: the LM named no object category for {shown!r} (answer "
+                          f"{e.raw[:80]!r}); asking about the goal itself", stacklevel=2)
+            cat = prompts.fallback_category(goal or f"handle the {', '.join(handled)}")
         with self._lock:
             self._category_memo[key] = cat
         return cat
@@ -382,11 +415,7 @@ class GiftProbKernel(SimilarityKernel):
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
         uses_category = "{category}" in prompts.RELEVANCE_TEMPLATES[self.template]
         if categories is None:
-            cat = self.category(intent) if uses_category else None
-            if cat is not None:
-                with self._lock:
-                    self.categories[prompts.goal_text(intent.text)] = cat
-            categories = [cat] * len(objects)
+            categories = [self.category(intent) if uses_category else None] * len(objects)
         elif len(categories) != len(objects):
             raise GiftError(f"gift-prob: {len(categories)} categories for {len(objects)} objects")
         out = np.empty(len(objects))
@@ -399,22 +428,40 @@ class GiftProbKernel(SimilarityKernel):
             out[i] = s
         return out
 
-    def _categories(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
-                    relevant_train: Sequence[str]) -> list[str] | None:
-        """Per object of ``test + train``, the category it is asked about; a training object's is named
-        without it (leave-one-out), so its score can calibrate a threshold. ``None``: the goal's alone."""
-        if (self.category_from != "goal+objects" or not relevant_train
-                or "{category}" not in prompts.RELEVANCE_TEMPLATES[self.template]):
-            return None
+    def _categories(self, n_test: int, train: Sequence[ObjectSpec], goal: str | None,
+                    relevant_train: Sequence[str]) -> list[str | None]:
+        """Per object of ``test + train``, the category it is asked about under one candidate ``goal`` (None:
+        from the objects alone): the full category for the test objects, and for each training object one
+        named without it (leave-one-out), so its score can calibrate a threshold and verify the candidate.
+        A relevant training object with no relevant partner left gets the goal's own category (or, without
+        a goal, the full one: its score is then not a fair leave-one-out score, and the alignment and the
+        verifier do not use it)."""
         rel = set(relevant_train)
         handled = [o.name for o in train if o.name in rel]
         alone = [o.name for o in train if o.name not in rel]
-        full = self.category(intent, handled, alone)
-        with self._lock:
-            self.categories[prompts.goal_text(intent.text)] = full
-        loo = [self.category(intent, [n for n in handled if n != o.name], [n for n in alone if n != o.name])
-               for o in train]
-        return [full] * len(test) + loo
+        full = self.category(goal, handled, alone)
+        loo = []
+        for o in train:
+            h = [n for n in handled if n != o.name]
+            a = [n for n in alone if n != o.name]
+            loo.append(self.category(goal, h, a) if (h or goal) else full)
+        return [full] * n_test + loo
+
+    def candidate_goals(self, intent: Intent, relevant_train: Sequence[str]) -> list[str | None]:
+        """The goals gift-prob names a category from (``candidates``): the intent's text; with ``"all"`` also
+        its other motivations and, when relevant training objects are known, no goal at all (the category
+        of the objects the demonstrations single out). Duplicates are dropped, in that order."""
+        goals: list[str | None] = [intent.text]
+        if self.candidates == "all":
+            goals += [m.text for m in intent.motivations]
+            if relevant_train:
+                goals.append(None)
+        out: list[str | None] = []
+        for g in goals:
+            key = None if g is None else prompts.goal_text(g).lower()
+            if key not in [None if x is None else prompts.goal_text(x).lower() for x in out]:
+                out.append(g)
+        return out
 
     @staticmethod
     def _relevant_mask(train: Sequence[ObjectSpec], relevant_train: Sequence[str],
@@ -448,25 +495,69 @@ class GiftProbKernel(SimilarityKernel):
         return np.nan_to_num(out, nan=0.0)
 
     # ------------------------------------------------------------------ kernel API
-    def scores(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
-               relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
-        """Unsquashed relevance scores of the test ``[n_test]`` and training objects ``[n_train]``.
+    def _verify(self, lo_train: np.ndarray, rel: np.ndarray, usable: np.ndarray) -> dict[str, float]:
+        """How well one candidate's leave-one-out log-odds separate the relevant training objects from the
+        others: AUC over the usable objects, and the margin (mean relevant minus mean other log-odds)."""
+        from gift.core.metrics import roc_auc
 
-        Training objects are scored leave-one-out (a training object is never compared with itself),
-        on the same scale as the test objects, so they can calibrate a threshold.
+        pos, neg = lo_train[rel & usable], lo_train[~rel & usable]
+        auc = roc_auc(lo_train[usable], rel[usable]) if pos.size and neg.size else float("nan")
+        margin = float(pos.mean() - neg.mean()) if pos.size and neg.size else float("nan")
+        return {"auc": auc, "margin": margin}
+
+    def score(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
+              relevant_train: Sequence[str] = ()) -> RelevanceScores:
+        """One pass over a scene: relevance of the test objects ``[n_test]`` and, leave-one-out, of the
+        training objects ``[n_train]`` (a training object is never compared with itself, and its question
+        uses a category named without it), on one scale, so the training scores can calibrate a cut.
+
+        With several candidate goals (``candidates="all"``) each one names a category and asks the
+        training objects' questions; the verifier keeps the candidate whose leave-one-out log-odds best
+        separate the relevant training objects from the others (AUC, then margin), and only its category
+        is asked about the test objects. ``details``: the category, the candidates with their verifier
+        scores, the weight of each term and each term per object (``terms``: ``lm`` log-odds and
+        ``language`` scores of the test and the training objects).
         """
         test, train = list(test), list(train)
         if intent is None:
             raise GiftError("the 'gift-prob' kernel conditions on an intent; pass one")
         rel = self._relevant_mask(train, relevant_train) if relevant_train else None  # unknown names fail first
-        lo = self.log_odds(test + train, intent, self._categories(test, train, intent, relevant_train))
+        uses_category = "{category}" in prompts.RELEVANCE_TEMPLATES[self.template]
+        details: dict[str, Any] = {}
+        if relevant_train and uses_category and self.category_from == "goal+objects":
+            usable = ~(rel & (rel.sum() < 2))  # a relevant object with no relevant partner left is no evidence
+            cands = []
+            for goal in self.candidate_goals(intent, relevant_train):
+                cats = self._categories(0, train, goal, relevant_train)
+                lo_train = self.log_odds(train, intent, cats)
+                cands.append({"goal": goal, "category": self.category(goal, *self._split(train, rel)),
+                              "lo_train": lo_train, **self._verify(lo_train, rel, usable)})
+            best = max(range(len(cands)), key=lambda k: (np.nan_to_num(cands[k]["auc"], nan=-1.0),
+                                                         np.nan_to_num(cands[k]["margin"], nan=-np.inf), -k))
+            chosen = cands[best]
+            lo = np.concatenate([self.log_odds(test, intent, [chosen["category"]] * len(test)), chosen["lo_train"]])
+            details["category"] = chosen["category"]
+            details["goal"] = chosen["goal"]
+            details["candidates"] = [{"goal": c["goal"], "category": c["category"], "auc": c["auc"],
+                                      "margin": c["margin"], "chosen": k == best} for k, c in enumerate(cands)]
+            if self.candidate_terms:
+                for c in details["candidates"]:
+                    k = details["candidates"].index(c)
+                    c["lm_train"] = cands[k]["lo_train"].tolist()
+                    c["lm_test"] = self.log_odds(test, intent, [c["category"]] * len(test)).tolist()
+        else:
+            lo = self.log_odds(test + train, intent)
+            if uses_category:
+                details["category"] = self.category(intent)
         lo_test, lo_train = lo[: len(test)], lo[len(test):]
-        if self.combine == "none":
-            return lo_test, lo_train
         if rel is None:
             rel = self._relevant_mask(train, (), lo_train)
+        details["terms"] = {"lm": {"test": lo_test.tolist(), "train": lo_train.tolist()}}
+        if self.combine == "none":
+            return RelevanceScores(_sigmoid(lo_test), _sigmoid(lo_train), rel, details)
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
+        details["terms"]["language"] = {"test": emb[: len(test)].tolist(), "train": emb[len(test):].tolist()}
         ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
         terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
         w = {"lm": 1.0 - self.weight, "language": self.weight}
@@ -476,52 +567,11 @@ class GiftProbKernel(SimilarityKernel):
             if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
                 w = scaled
         total = sum(w.values())
-        self.last_weights = {t: v / total for t, v in w.items()}
-        z = sum(self.last_weights[t] * terms[t] for t in terms)
-        out = z[: len(test)], z[len(test):]
-        self._last = (self._train_key(train, intent, relevant_train), out[1])
-        return out
+        weights = {t: v / total for t, v in w.items()}
+        z = sum(weights[t] * terms[t] for t in terms)
+        details["weights"] = weights
+        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details)
 
     @staticmethod
-    def _train_key(train: Sequence[ObjectSpec], intent: Intent, relevant_train: Sequence[str]) -> tuple:
-        return (tuple(train), intent, tuple(sorted(relevant_train)))
-
-    def relevance(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
-                  relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """``r`` ``[n_test]`` in [0, 1]: sigmoid of the relevance score (0.5 = undecided)."""
-        if not test:
-            return np.zeros(0)
-        return _sigmoid(self.scores(test, train, intent, relevant_train)[0])
-
-    def relevance_loo(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
-                      relevant_train: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
-        """``(r_test [n_test], r_train [n_train])`` in [0, 1] from one call, on one scale.
-
-        ``r_train`` is leave-one-out (no training object is compared with itself): the scores a
-        train-calibrated threshold should separate (relevant training objects vs the others).
-        """
-        s_test, s_train = self.scores(test, train, intent, relevant_train)
-        return _sigmoid(s_test), _sigmoid(s_train)
-
-    def loo_relevance(self, train: Sequence[ObjectSpec], intent: Intent | None = None,
-                      relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """Leave-one-out ``r`` ``[n_train]`` of the training objects (the alignment operator's calibration).
-
-        On the scale of the last :meth:`relevance` call with the same training set, intent and
-        ``relevant_train`` (z-scores depend on the pool of objects scored together); else on its own.
-        """
-        key = self._train_key(train, intent, relevant_train)
-        if self._last is not None and self._last[0] == key:
-            return _sigmoid(self._last[1])
-        return _sigmoid(self.scores([], train, intent, relevant_train)[1])
-
-    def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
-                   intent: Intent | None = None, relevant_train: Sequence[str] = ()) -> np.ndarray:
-        """``[n_test, n_train]``: ``r_i`` in the columns of the relevant training objects, 0 elsewhere."""
-        test, train = list(test), list(train)
-        if not test or not train:
-            return np.zeros((len(test), len(train)))
-        s_test, _ = self.scores(test, train, intent, relevant_train)
-        rel = (self._relevant_mask(train, relevant_train) if relevant_train
-               else self._relevant_mask(train, (), self.log_odds(train, intent)))
-        return np.where(rel[None, :], _sigmoid(s_test)[:, None], 0.0)
+    def _split(train: Sequence[ObjectSpec], rel: np.ndarray) -> tuple[list[str], list[str]]:
+        return ([o.name for o, r in zip(train, rel) if r], [o.name for o, r in zip(train, rel) if not r])

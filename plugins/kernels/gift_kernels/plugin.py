@@ -1,4 +1,4 @@
-"""Entry point of gift_kernels: registers its components with gift."""
+"""Entry point of gift_kernels: registers its kernels, the intent estimator and the component-level commands."""
 
 from gift.plugins.hookspecs import hookimpl
 
@@ -6,18 +6,16 @@ from gift.plugins.hookspecs import hookimpl
 @hookimpl
 def gift_register_kernels(register):
     from gift_kernels.language import LanguageKernel
+    from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel
     from gift_kernels.vision import VisionKernel
 
-    register("language", LanguageKernel, description="cosine of all-MiniLM-L6-v2 embeddings of names "
+    register(LanguageKernel, description="cosine of all-MiniLM-L6-v2 embeddings of names "
              "(use_descriptions=True: names + descriptions)")
-    register("vision", VisionKernel, description="cosine of EfficientNet-Lite0 features of three renders per object")
-
-    from gift_kernels.lm_kernels import GiftProbKernel, MappingKernel, NoIntentMappingKernel
-
-    register("gift", MappingKernel, description="GIFT Call 3: LM maps test objects under the intent; K = vote "
+    register(VisionKernel, description="cosine of EfficientNet-Lite0 features of three renders per object")
+    register(MappingKernel, description="GIFT Call 3: LM maps test objects under the intent; K = vote "
              "share of N samples (default 10)")
-    register("lm-no-intent", NoIntentMappingKernel, description="Call 3 without the intent (the paper's ablation)")
-    register("gift-prob", GiftProbKernel, description="continuous GIFT kernel: LM log-odds that an object is what "
+    register(NoIntentMappingKernel, description="Call 3 without the intent (the paper's ablation)")
+    register(GiftProbKernel, description="continuous GIFT kernel: LM log-odds that an object is what "
              "the goal is about, z-averaged with MiniLM description similarity")
 
 
@@ -25,30 +23,15 @@ def gift_register_kernels(register):
 def gift_register_intent_estimators(register):
     from gift_kernels.intent import LMContrastiveIntentEstimator
 
-    register("lm-contrastive", LMContrastiveIntentEstimator,
+    register(LMContrastiveIntentEstimator,
              description="GIFT Calls 1-2: motivations from preferred-vs-default traces, then semantic axes")
 
 
 @hookimpl
-def gift_register_alignment_operators(register):
-    from gift_kernels.alignment import ArgmaxThresholdAlignment
-
-    register("argmax-threshold", ArgmaxThresholdAlignment,
-             description="argmax over training objects, distractor below a threshold "
-                         "(oracle | non-oracle | train-calibrated | float)")
-
-
-@hookimpl
 def gift_register_commands(register):
-    from gift_kernels import cli
+    from gift_kernels import cli, intent_cli
 
     register("align", cli.run_align, help="align test objects to training objects with a kernel",
              configure=cli.configure_align)
-    register("evaluate-alignment", cli.run_evaluate_alignment,
-             help="precision/recall/F1/AUC/FP/FN of kernels on a suite, per intent and per subset",
-             configure=cli.configure_evaluate_alignment)
-
-    from gift_kernels import intent_cli
-
     register("infer-intent", intent_cli.run_infer_intent, help="infer the intent (Calls 1-2) from saved "
              "demonstration pairs", configure=intent_cli.configure_infer_intent)

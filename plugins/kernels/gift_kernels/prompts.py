@@ -33,7 +33,8 @@ Reply with one JSON object and nothing else:
 {"motivations": [{"text": "<one or two sentences>", "features": ["<feature name>", ...]}, ... three entries, \
 most likely first],
  "semantic_similarities": [{"question": "<a short yes/no question>", "features": ["<feature name>", ...]}, ...]}
-Use only feature names that appear in the recordings or in the list of other features."""
+Name one to four features per entry and at most three semantic similarities. Use only feature names that \
+appear in the recordings or in the list of other features."""
 
 
 def intent_messages(pairs_text: Sequence[tuple[str, str]], descriptions: Mapping[str, str],
@@ -64,7 +65,8 @@ motivations and a list of object names. Write short yes/no questions (for exampl
 and, for each question, the objects for which the answer is yes. Use only the given object names; put \
 each object under at most one question; avoid vague questions such as "is it an object?".
 
-Reply with one JSON object and nothing else: {"axes": [{"question": "...", "objects": ["...", ...]}, ...]}"""
+Reply with one JSON object and nothing else: {"axes": [{"question": "...", "objects": ["...", ...]}, ...]} \
+with one to six questions, each with at least one object."""
 
 
 def axes_messages(motivations: Sequence[tuple[str, Sequence[str]]], objects: Sequence[str]) -> tuple[Message, ...]:
@@ -84,7 +86,8 @@ yes/no grouping questions). Map every new object either to the training object w
 judged by purpose and use rather than by name or looks, or to "{DISTRACTOR}" when it takes no training \
 object's role. Several new objects may map to the same training object.
 
-Reply with one JSON object and nothing else: {{"<new object>": "<training object or {DISTRACTOR}>", ...}}"""
+Reply with one JSON object and nothing else: {{"<new object>": "<training object or {DISTRACTOR}>", ...}} \
+with every new object as a key, in the order they are listed."""
 
 
 def intent_context(intent: Intent) -> str:
@@ -145,16 +148,22 @@ def goal_text(text: str) -> str:
 
 # ----------------------------------------------------------------------------- goal category (gift-prob)
 
-CATEGORY_SYSTEM = "You name the kind of object a household goal is about, as a short plural noun phrase."
+CATEGORY_SYSTEM = ("You name the kind of object a household goal is about, as a short plural noun phrase. "
+                   'Reply with one JSON object and nothing else: {"category": "<noun phrase>"}')
 
-#: Worked examples shown before the goal (generic household goals, none from a benchmark suite). They
-#: teach the small model to keep the goal's own qualifiers ("gardening tools", not "tools") and, when a
-#: goal names two kinds of object, to name the kind the goal acts on or protects.
+
+def category_answer(category: str) -> str:
+    """A worked example's answer, in the JSON of ``schemas.category_schema``."""
+    return json.dumps({"category": category})
+
+#: Worked examples shown before the goal. Written before any result was seen, from household goals that share
+#: no object and no kind of goal with any shipped suite (gift-paper, gift-dev, lm-dev; checked by a test).
+#: They show the answer's form: the kind of object in the goal's own words, as a plural noun phrase.
 CATEGORY_EXAMPLES: tuple[tuple[str, str], ...] = (
-    ("put the gardening tools back in the shed", "gardening tools"),
-    ("keep the candle away from flammable things", "flammable things"),
-    ("wrap the fragile things before the move", "fragile things"),
-    ("hand me something to write with", "things to write with"),
+    ("put the aquarium supplies on the shelf", "aquarium supplies"),
+    ("get the car cleaning things ready", "car cleaning things"),
+    ("keep the toddler away from anything with small parts", "things with small parts"),
+    ("bring me something to hang the picture with", "things to hang a picture with"),
 )
 
 
@@ -162,41 +171,44 @@ def category_messages(goal: str) -> tuple[Message, ...]:
     """Ask which kind of object ``goal`` is about (few-shot, answered with a plural noun phrase)."""
     msgs = [Message("system", CATEGORY_SYSTEM)]
     for g, c in CATEGORY_EXAMPLES:
-        msgs += [Message("user", f"Goal: {g}.\nWhich objects is this goal about?"), Message("assistant", c)]
+        msgs += [Message("user", f"Goal: {g}.\nWhich objects is this goal about?"),
+                 Message("assistant", category_answer(c))]
     msgs.append(Message("user", f"Goal: {goal_text(goal)}.\nWhich objects is this goal about?"))
     return tuple(msgs)
 
 
-#: Worked examples for naming the category from the goal *and* the demonstrated objects (household
-#: goals from neither suite). The second and third teach the model to generalise from a goal that names
-#: one object, or names none of the objects it is about, to the kind the handled objects share.
+#: Worked examples for naming the kind of object from the objects a goal concerned and those it did not
+#: (and, when there is one, the goal). Same rules as :data:`CATEGORY_EXAMPLES`: no object and no kind of
+#: goal of any shipped suite. The goals are phrased in different ways, none naming the kind's members.
 CATEGORY_EXAMPLES_WITH_OBJECTS: tuple[tuple[str, tuple[str, ...], tuple[str, ...], str], ...] = (
-    ("put the gardening tools back in the shed", ("trowel", "pruning shears"), ("umbrella", "bicycle pump"),
-     "gardening tools"),
-    ("The person wanted to put the ski goggles in the bag", ("ski goggles", "ski gloves"),
-     ("sunglasses", "tennis racket"), "ski gear"),
-    ("carry the tray quickly to the table", ("candle", "paper lantern"), ("ceramic mug", "steel pot"),
-     "flammable things"),
-    ("wrap the fragile things before the move", ("wine glass", "porcelain plate"),
-     ("wool blanket", "plastic bucket"), "fragile things"),
+    ("put the aquarium supplies on the shelf", ("aquarium net", "fish food flakes"), ("tripod", "kettle"),
+     "aquarium supplies"),
+    ("get the car cleaning things ready", ("car wax tin", "windshield squeegee"), ("toaster", "desk lamp"),
+     "car cleaning things"),
+    ("keep the toddler away from anything with small parts", ("bag of marbles", "box of push pins"),
+     ("beach ball", "floor cushion"), "things with small parts"),
+    ("get ready for the party", ("party hat", "confetti cannon"), ("tire gauge", "bath mat"), "party supplies"),
 )
 
 
-def _objects_question(goal: str, handled: Sequence[str], left_alone: Sequence[str]) -> str:
-    return (f"Goal: {goal_text(goal)}.\nObjects the person handled as part of this goal: {', '.join(handled)}.\n"
-            f"Objects they left alone: {', '.join(left_alone) or 'none'}.\n"
-            f"Which kind of objects is this goal about?")
+def _objects_question(goal: str | None, handled: Sequence[str], left_alone: Sequence[str]) -> str:
+    head = f"Goal: {goal_text(goal)}.\n" if goal else ""
+    return (f"{head}Objects the person's goal concerned (they acted on them or kept clear of them): "
+            f"{', '.join(handled)}.\nObjects it did not concern: {', '.join(left_alone) or 'none'}.\n"
+            f"Which kind of objects is {'this goal' if goal else 'the goal'} about?")
 
 
-def category_from_objects_messages(goal: str, handled: Sequence[str],
+def category_from_objects_messages(goal: str | None, handled: Sequence[str],
                                    left_alone: Sequence[str]) -> tuple[Message, ...]:
-    """Ask which kind of object ``goal`` is about, given the training objects the demonstrations
-    treated as part of it (``handled``, at least one) and the others (few-shot, a plural noun phrase)."""
+    """Ask which kind of object a goal is about, given the training objects the demonstrations treated as
+    part of it (``handled``, at least one) and the others, and the goal's text when there is one
+    (``goal=None``: from the objects alone, the easiest question for a small model)."""
     if not handled:
         raise ValueError("category_from_objects_messages needs at least one handled object")
     msgs = [Message("system", CATEGORY_SYSTEM)]
     for g, h, a, c in CATEGORY_EXAMPLES_WITH_OBJECTS:
-        msgs += [Message("user", _objects_question(g, h, a)), Message("assistant", c)]
+        msgs += [Message("user", _objects_question(g if goal else None, h, a)),
+                 Message("assistant", category_answer(c))]
     msgs.append(Message("user", _objects_question(goal, handled, left_alone)))
     return tuple(msgs)
 

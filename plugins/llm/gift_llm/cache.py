@@ -13,6 +13,11 @@ cache; statistics are still kept.
 
 Single-flight: when several threads or processes miss the same key at once, one calls the model and the
 others wait for its answer (a per-key ``flock`` next to the SQLite file, a ``SET NX PX`` lock in Redis).
+
+A damaged SQLite file (``file is not a database``, ``database disk image is malformed``) does not stop a
+run: the file (with its ``-wal``/``-shm`` companions) is moved aside to ``<file>.corrupt-<time>``, a warning
+names both paths, and an empty cache takes its place; the old file is kept for inspection. ``gift lm
+cache-stats --repair`` runs SQLite's full integrity check and does the same when it fails.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ import attrs
 from gift.core.data import Completion, Message, Usage
 from gift.core.errors import LMError
 from gift.core.interfaces import LMBackend
+from gift.core.redaction import redact_text
 from gift_llm.paths import lm_cache_path, lm_cache_url
 from gift_llm.requests import choices_request, complete_request, request_key
 from gift_llm.usage import MeteredLM
@@ -101,6 +107,7 @@ class SQLiteStore:
         self.lock_timeout_s = float(lock_timeout_s)
         self.lock_dir = Path(lock_dir) if lock_dir else _default_lock_dir(self.path)
         self._local = threading.local()
+        self._generation = 0
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as e:
@@ -108,15 +115,16 @@ class SQLiteStore:
 
     def _conn(self) -> sqlite3.Connection:
         conn = getattr(self._local, "conn", None)
-        if conn is None or getattr(self._local, "pid", None) != os.getpid():
+        if (conn is None or getattr(self._local, "pid", None) != os.getpid()
+                or getattr(self._local, "generation", None) != self._generation):
             conn = self._open()
-            self._local.conn, self._local.pid = conn, os.getpid()
+            self._local.conn, self._local.pid, self._local.generation = conn, os.getpid(), self._generation
         return conn
 
     def _open(self) -> sqlite3.Connection:
         # Switching a new file to WAL can fail with "database is locked" without waiting for the busy
         # timeout when several connections open it at the same moment: retry until ``timeout_s``.
-        deadline, delay = time.monotonic() + self.timeout_s, 0.005
+        deadline, delay, recovered = time.monotonic() + self.timeout_s, 0.005, False
         while True:
             conn = None
             try:
@@ -128,42 +136,127 @@ class SQLiteStore:
             except sqlite3.Error as e:
                 if conn is not None:
                     conn.close()
+                if _is_damaged(e) and not recovered:
+                    self._recover(e)
+                    recovered = True
+                    continue
                 if not (isinstance(e, sqlite3.OperationalError) and "locked" in str(e)
                         and time.monotonic() < deadline):
-                    raise LMError(f"LM cache: cannot open {self.path}: {e}") from e
+                    raise LMError(f"LM cache: cannot open {self.path}: {e}{self._advice(e)}") from e
             time.sleep(delay)
             delay = min(delay * 2, 0.1)
 
-    def get(self, key: str) -> Any | None:
+    def _execute(self, what: str, fn: Callable[[sqlite3.Connection], Any]) -> Any:
+        """``fn(connection)``; a damaged file is moved aside once (:meth:`_recover`) and ``fn`` retried."""
+        for attempt in (0, 1):
+            try:
+                return fn(self._conn())
+            except sqlite3.Error as e:
+                if attempt == 0 and _is_damaged(e):
+                    self._recover(e)
+                    continue
+                raise LMError(f"LM cache: {what} {self.path} failed: {e}{self._advice(e)}") from e
+
+    def _advice(self, error: sqlite3.Error) -> str:
+        if not _is_damaged(error):
+            return ""
+        return (f". The file is damaged: move it aside (mv {self.path} {self.path}.bad) or run `gift lm cache-stats "
+                f"--repair`; gift then starts an empty cache")
+
+    # ------------------------------------------------------------------ damaged files
+    def integrity_problem(self, full: bool = True) -> str | None:
+        """What SQLite's ``integrity_check`` (``quick_check`` unless ``full``) finds wrong with the file, or None."""
+        if not self.path.exists():
+            return None
+        conn = None
         try:
-            row = self._conn().execute("SELECT response FROM entries WHERE key = ?", (key,)).fetchone()
+            conn = sqlite3.connect(self.path, timeout=self.timeout_s, isolation_level=None)
+            rows = conn.execute(f"PRAGMA {'integrity_check' if full else 'quick_check'}(5)").fetchall()
+            return "; ".join(r[0] for r in rows if r[0] != "ok") or None
         except sqlite3.Error as e:
-            raise LMError(f"LM cache: read from {self.path} failed: {e}") from e
+            return str(e)
+        finally:
+            if conn is not None:
+                conn.close()
+
+    def move_aside(self, reason: str = "") -> Path:
+        """Rename the file (and its ``-wal``/``-shm``) to ``<file>.corrupt-<time>``; the next use starts empty."""
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        aside = self.path.with_name(f"{self.path.name}.corrupt-{stamp}")
+        k = 1
+        while aside.exists():
+            aside = self.path.with_name(f"{self.path.name}.corrupt-{stamp}-{k}")
+            k += 1
+        try:
+            for suffix in ("", "-wal", "-shm"):
+                src = Path(str(self.path) + suffix)
+                if src.exists():
+                    os.replace(src, Path(str(aside) + suffix))
+        except OSError as e:
+            raise LMError(f"LM cache: {self.path} is damaged ({reason or 'integrity check failed'}) and cannot be "
+                          f"moved aside ({e}): move it away by hand (mv {self.path} {aside}) or point "
+                          f"GIFT_CACHE_DIR elsewhere; gift then starts an empty cache") from e
+        self._generation += 1  # every thread of this process reconnects to the new file
+        warnings.warn(f"LM cache: {self.path} is damaged ({reason or 'integrity check failed'}); moved it to {aside} "
+                      f"and started an empty cache there. The old file is kept: delete it when you do not need it",
+                      RuntimeWarning, stacklevel=3)
+        return aside
+
+    def repair(self) -> dict[str, Any]:
+        """Full integrity check; a damaged file is moved aside (:meth:`move_aside`). ``{"problem", "moved_to"}``."""
+        with self._repair_lock():
+            problem = self.integrity_problem(full=True)
+            moved = self.move_aside(problem) if problem else None
+        return {"problem": problem, "moved_to": str(moved) if moved else None}
+
+    def _recover(self, error: sqlite3.Error) -> None:
+        """The file failed with ``error``: move it aside unless another thread or process already did."""
+        conn, self._local.conn = getattr(self._local, "conn", None), None
+        if conn is not None:
+            with contextlib.suppress(sqlite3.Error):
+                conn.close()
+        with self._repair_lock():
+            problem = self.integrity_problem(full=False)
+            if problem is None:
+                return  # already replaced by a healthy (or no) file
+            self.move_aside(problem)
+
+    @contextlib.contextmanager
+    def _repair_lock(self) -> Iterator[None]:
+        path = self.lock_dir / "repair.lock"
+        fd = _flock(path, self.timeout_s)
+        try:
+            yield
+        finally:
+            if fd is not None:
+                _unflock(path, fd)
+
+    # ------------------------------------------------------------------ entries
+    def get(self, key: str) -> Any | None:
+        row = self._execute("read from", lambda c: c.execute("SELECT response FROM entries WHERE key = ?",
+                                                             (key,)).fetchone())
         return None if row is None else json.loads(row[0])
 
     def put(self, key: str, kind: str, identity: str, request: Mapping[str, Any], response: Any) -> None:
-        try:
-            self._conn().execute(
-                "INSERT OR REPLACE INTO entries (key, kind, identity, request, response, created) "
-                "VALUES (?, ?, ?, ?, ?, ?)",
-                (key, kind, identity, json.dumps(request, ensure_ascii=False), json.dumps(response), time.time()))
-        except sqlite3.Error as e:
-            raise LMError(f"LM cache: write to {self.path} failed: {e}") from e
+        row = (key, kind, identity, json.dumps(request, ensure_ascii=False), json.dumps(response), time.time())
+        self._execute("write to", lambda c: c.execute(
+            "INSERT OR REPLACE INTO entries (key, kind, identity, request, response, created) "
+            "VALUES (?, ?, ?, ?, ?, ?)", row))
 
     def count(self) -> int:
-        return int(self._conn().execute("SELECT COUNT(*) FROM entries").fetchone()[0])
+        return int(self._execute("read from", lambda c: c.execute("SELECT COUNT(*) FROM entries").fetchone()[0]))
 
     def summary(self) -> dict[str, Any]:
-        rows = self._conn().execute("SELECT identity, kind, COUNT(*) FROM entries GROUP BY identity, kind").fetchall()
+        rows = self._execute("read from", lambda c: c.execute(
+            "SELECT identity, kind, COUNT(*) FROM entries GROUP BY identity, kind").fetchall())
         size = self.path.stat().st_size if self.path.exists() else 0
         return {"path": str(self.path), "store": self.kind, "entries": sum(r[2] for r in rows), "bytes": size,
-                "by_model": [{"identity": r[0], "kind": r[1], "entries": r[2]} for r in sorted(rows)]}
+                "by_model": [{"identity": redact_text(r[0]), "kind": r[1], "entries": r[2]} for r in sorted(rows)]}
 
     def clear(self, identity: str | None = None) -> int:
-        conn = self._conn()
-        cur = (conn.execute("DELETE FROM entries WHERE identity = ?", (identity,)) if identity
-               else conn.execute("DELETE FROM entries"))
-        return cur.rowcount
+        return self._execute("delete from", lambda c: (
+            c.execute("DELETE FROM entries WHERE identity = ?", (identity,)) if identity
+            else c.execute("DELETE FROM entries")).rowcount)
 
     @contextlib.contextmanager
     def lock(self, key: str) -> Iterator[bool]:
@@ -185,6 +278,21 @@ class SQLiteStore:
 
 
 CacheStore = SQLiteStore  # the name before the Redis store existed
+
+
+#: SQLite result codes of a damaged file: SQLITE_CORRUPT, SQLITE_NOTADB.
+_DAMAGED_CODES = (11, 26)
+
+
+def _is_damaged(error: BaseException) -> bool:
+    """True for SQLite's "file is not a database" and "database disk image is malformed" errors."""
+    if not isinstance(error, sqlite3.DatabaseError):
+        return False
+    code = getattr(error, "sqlite_errorcode", None)
+    if code is not None:
+        return (code & 0xFF) in _DAMAGED_CODES
+    text = str(error)
+    return "not a database" in text or "malformed" in text
 
 
 def _default_lock_dir(db: Path) -> Path:

@@ -5,6 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 
+from gift.core.errors import GiftError
+from gift.core.serialization import dumps
+
 
 def configure(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="lm_command", metavar="ACTION", required=True)
@@ -29,6 +32,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     s.add_argument("--identity", default=None, help="with --clear: only the entries of this backend identity")
     s.add_argument("--url", default=None, help="a Redis cache, redis://host:port/db (default: $GIFT_LM_CACHE_URL, "
                                                "else the SQLite file)")
+    s.add_argument("--repair", action="store_true",
+                   help="run SQLite's full integrity check; a damaged file is moved aside (kept as "
+                        "<file>.corrupt-<time>) and an empty cache started")
     s.add_argument("--json", action="store_true")
 
 
@@ -67,7 +73,7 @@ def _ask(args: argparse.Namespace) -> int:
     stats = getattr(lm, "stats", None)
     if stats is not None:
         result["stats"] = stats.as_dict()
-    print(json.dumps(result, indent=2, ensure_ascii=False, default=str) if args.json else shown)
+    print(dumps(result, indent=2, ensure_ascii=False, default=str) if args.json else shown)
     return 0
 
 
@@ -82,13 +88,23 @@ def _cache_stats(args: argparse.Namespace) -> int:
     from gift_llm.cache import open_store
 
     store = open_store(url=args.url)
+    repaired = None
+    if args.repair:
+        if not hasattr(store, "repair"):
+            raise GiftError(f"--repair checks the SQLite cache file; {store.location} is a {store.kind} server")
+        repaired = store.repair()
     removed = store.clear(args.identity) if args.clear else None
     info = store.summary()
     if removed is not None:
         info["removed"] = removed
+    if repaired is not None:
+        info["repair"] = repaired
     if args.json:
-        print(json.dumps(info, indent=2))
+        print(dumps(info, indent=2))
         return 0
+    if repaired is not None:
+        print(f"integrity check: {'ok' if repaired['problem'] is None else repaired['problem']}"
+              + (f"; the damaged file was moved to {repaired['moved_to']}" if repaired["moved_to"] else ""))
     print(f"{info['path']}: {info['entries']} entries, {info['bytes'] / 1e6:.2f} MB"
           + (f" ({removed} removed)" if removed is not None else ""))
     for row in info["by_model"]:

@@ -43,6 +43,13 @@ def gift_register_lm_backends(register):
 
 
 @hookimpl
+def gift_resolve_lm(spec, options):
+    from gift_llm.resolve import resolve_lm
+
+    return resolve_lm(spec, **options)
+
+
+@hookimpl
 def gift_register_commands(register):
     from gift_llm.cli import configure, run
 

@@ -18,24 +18,15 @@ import uuid
 import warnings
 from collections.abc import Iterator, Mapping
 from typing import Any
-from urllib.parse import urlsplit, urlunsplit
+from urllib.parse import urlsplit
 
 from gift.core.errors import LMError
+from gift.core.redaction import redact_url
 
 _SCHEMES = ("redis", "rediss", "unix")
 # Delete the lock only if it is still ours (it may have expired and been taken by another worker).
 _RELEASE = "if redis.call('get', KEYS[1]) == ARGV[1] then return redis.call('del', KEYS[1]) else return 0 end"
 _BATCH = 500
-
-
-def redacted_url(url: str) -> str:
-    """``url`` with any password replaced by ``***`` (for messages and summaries)."""
-    parts = urlsplit(url)
-    if parts.password is None:
-        return url
-    netloc = parts.netloc.rsplit("@", 1)
-    user = parts.username or ""
-    return urlunsplit(parts._replace(netloc=f"{user}:***@{netloc[-1]}"))
 
 
 class RedisStore:
@@ -51,7 +42,7 @@ class RedisStore:
     def __init__(self, url: str, *, namespace: str = "gift:lm", lock_timeout_s: float = 600.0,
                  connect_timeout_s: float = 5.0):
         self.url = str(url)
-        self.location = redacted_url(self.url)
+        self.location = redact_url(self.url)
         if urlsplit(self.url).scheme not in _SCHEMES:
             raise LMError(f"LM cache: unsupported cache URL {self.location!r}: expected redis://host:port/db "
                           f"(or rediss://, unix://)")

@@ -1,14 +1,24 @@
-"""Ask an LM for a dictionary: parse it from free text, validate it, ask for repairs, then fail clearly."""
+"""Ask an LM for a dictionary: parse it from free text, validate it, ask for repairs, then fail clearly.
+
+With a ``json_schema``, backends that constrain decoding (``llamacpp``: a grammar) can only produce a
+dictionary of that schema; the parsing, the validation and the repair requests stay for the backends
+that cannot, and for what a schema cannot say.
+"""
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from typing import Any
+
+import attrs
 
 from gift.core.data import Message, as_messages
 from gift.core.errors import LMAnswerError
 from gift.core.interfaces import LMBackend
 from gift_llm.parsing import extract_dict
+
+log = logging.getLogger(__name__)
 
 REPAIR_PROMPT = ("Your previous answer could not be used: {problem}\n"
                  "Reply again with only the corrected Python dictionary, nothing else.")
@@ -62,16 +72,34 @@ def check_dict(d: dict, *, required_keys: Iterable[Any] = (),
     return out
 
 
+@attrs.define
+class AskStats:
+    """Running counts of the :func:`ask_dict` calls that share this object (one per kernel or estimator).
+
+    ``asked``: dictionaries asked for; ``answers``: LM answers read (first answers and repairs);
+    ``repairs``: repair requests sent; ``failed``: calls that ended in :class:`LMAnswerError`.
+    """
+
+    asked: int = 0
+    answers: int = 0
+    repairs: int = 0
+    failed: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        return attrs.asdict(self)
+
+
 def ask_dict(lm: LMBackend, messages: Sequence[Message] | str, *,
              validate: Callable[[dict], dict | None] | None = None, required_keys: Iterable[Any] = (),
              allowed_values: Collection[Any] | Mapping[Any, Collection[Any]] | None = None, max_repairs: int = 2,
              temperature: float = 0.0, seed: int | None = None, max_tokens: int = 512,
-             json_schema: Mapping[str, Any] | None = None) -> dict:
+             json_schema: Mapping[str, Any] | None = None, stats: AskStats | None = None) -> dict:
     """Complete ``messages``, extract the last dictionary of the answer and validate it.
 
     ``validate(d)`` may raise :class:`ValueError` (its message goes into the repair request) or return a
     replacement dict. On a parse or validation failure the model is shown its answer and what was wrong,
-    up to ``max_repairs`` times; then :class:`LMAnswerError` carries the last raw answer.
+    up to ``max_repairs`` times; then :class:`LMAnswerError` carries the last raw answer. ``json_schema``
+    goes with every request (first answer and repairs); ``stats`` counts answers, repairs and failures.
     """
     if max_repairs < 0:
         raise ValueError(f"max_repairs must be >= 0, got {max_repairs}")
@@ -79,9 +107,15 @@ def ask_dict(lm: LMBackend, messages: Sequence[Message] | str, *,
     chat = list(as_messages(messages))
     problems: list[str] = []
     raw = ""
+    if stats is not None:
+        stats.asked += 1
     for attempt in range(max_repairs + 1):
+        if attempt and stats is not None:
+            stats.repairs += 1
         raw = lm.complete(chat, temperature=temperature, seed=seed, max_tokens=max_tokens,
                           json_schema=json_schema).text
+        if stats is not None:
+            stats.answers += 1
         try:
             d = extract_dict(raw)
             d = check_dict(d, required_keys=required_keys, allowed_values=allowed_values)
@@ -95,7 +129,11 @@ def ask_dict(lm: LMBackend, messages: Sequence[Message] | str, *,
         except ValueError as e:
             problem = str(e)
         problems.append(f"attempt {attempt + 1}: {problem}")
+        log.info("%s: answer %d invalid%s: %s", lm.identity(), attempt + 1,
+                 " (with a JSON schema)" if json_schema is not None else "", problem[:300])
         chat += [Message("assistant", raw), Message("user", REPAIR_PROMPT.format(problem=problem))]
+    if stats is not None:
+        stats.failed += 1
     raise LMAnswerError(f"{lm.identity()} gave no valid dictionary after {max_repairs} repair request(s): "
                         + " | ".join(problems), raw)
 

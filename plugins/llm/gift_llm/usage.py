@@ -85,6 +85,9 @@ class LMWrapper(LMBackend):
     def identity(self) -> str:
         return self.inner.identity()
 
+    def provenance(self) -> dict[str, Any]:
+        return self.inner.provenance()
+
     def __getattr__(self, item: str) -> Any:
         if item == "inner":  # not yet set (during unpickling): avoid infinite recursion
             raise AttributeError(item)

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gift_rewards.linear_maxent import LinearMaxEntReward, maxent_objective
-from gift_rewards.maxent_base import MaxEntReward, NotFittedError, read_reward_file
+from gift_rewards.maxent_irl import MaxEntReward, NotFittedError, read_reward_file
 from gift_rewards.neural_maxent import NeuralMaxEntReward
 from gift_rewards.trajectory_features import aggregate, aggregate_names
 

@@ -2,7 +2,7 @@
 
 φ is :func:`gift_rewards.trajectory_features.aggregate` (mean over time and final step of every
 feature), so θ has 2F entries; :attr:`LinearMaxEntReward.weights` names them ``mean:<feature>`` and
-``final:<feature>``. The objective and its proposal are described in :mod:`gift_rewards.maxent_base`.
+``final:<feature>``. The objective and its proposal are described in :mod:`gift_rewards.maxent_irl`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from scipy.special import logsumexp, softmax
 
 from gift.core.alignment import AlignmentPlan
 from gift.core.errors import GiftError, ValidationError
-from gift_rewards.maxent_base import MaxEntReward, uniform_log_weights
+from gift_rewards.maxent_irl import MaxEntReward, uniform_log_weights
 from gift_rewards.trajectory_features import aggregate, aggregate_names
 
 

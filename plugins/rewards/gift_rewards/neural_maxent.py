@@ -5,7 +5,7 @@ One MLP reads a state's standardised features ``s_t`` ``[F]`` and gives two numb
 ``r_t = r_run(s_t) / T + [t = T] · r_end(s_t)`` and R_ψ(ξ) = Σ_t r_t: the nonlinear counterpart of the
 linear model's "mean over time + final step" features, so both models can express the same rewards.
 
-Training maximises the MaxEnt objective of :mod:`gift_rewards.maxent_base` (uniform proposal, L2 on the
+Training maximises the MaxEnt objective of :mod:`gift_rewards.maxent_irl` (uniform proposal, L2 on the
 weight matrices) with full-batch Adam in float32 on ``threads`` CPU threads (1 by default: this small net
 gains nothing from more, and loses much on a busy machine). ``torch.manual_seed(seed)`` fixes the
 initialisation, and training stops early when the log-likelihood of held-out demonstrations (normalised
@@ -24,7 +24,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from gift.core.errors import GiftError, ValidationError
-from gift_rewards.maxent_base import MaxEntReward, uniform_log_weights
+from gift_rewards.maxent_irl import MaxEntReward, uniform_log_weights
 
 #: Trajectories per block when scoring (bounds the memory of the hidden activations).
 SCORE_BLOCK = 2048

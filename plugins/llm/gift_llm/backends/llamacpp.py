@@ -138,6 +138,12 @@ class LlamaCppLM(LMBackend):
     def identity(self) -> str:
         return f"{self.name}:{self.model}"
 
+    def provenance(self) -> dict[str, Any]:
+        """Identity, path and SHA-256 of the GGUF file this backend loads (hashed once per file version)."""
+        from gift.core.provenance import file_sha256
+
+        return {"identity": self.identity(), "model_path": str(self.path), "model_sha256": file_sha256(self.path)}
+
     def _grammar(self, schema: Mapping[str, Any]) -> Any:
         from llama_cpp import LlamaGrammar
         from llama_cpp.llama_grammar import JSON_GBNF
