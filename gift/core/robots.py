@@ -4,8 +4,8 @@ A plugin registers a :class:`RobotSpec` through the ``gift_register_robots`` hoo
 
     @gift.hookimpl
     def gift_register_robots(register):
-        register("ur5e", RobotSpec(name="ur5e", urdf="ur5e.urdf", package="my_robot_pkg", base_link="base_link",
-                                   ee_link="tcp", rest=(0.0, -1.9, 1.9, -1.57, -1.57, 0.0)))
+        register(RobotSpec(name="ur5e", urdf="ur5e.urdf", package="my_robot_pkg", base_link="base_link",
+                           ee_link="tcp", rest=(0.0, -1.9, 1.9, -1.57, -1.57, 0.0)))     # under spec.name
 
 ``gift.get_robot("ur5e")`` returns the spec. Simulator plugins consume it (gift-sim-drake registers one
 simulator ``drake-<name>`` per registered robot). Nothing here imports a simulator: joint limits, the

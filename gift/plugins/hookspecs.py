@@ -56,8 +56,8 @@ def gift_register_simulators(register: Register) -> None:
 
 @hookspec
 def gift_register_robots(register: Register) -> None:
-    """Register robot arms: ``register(name, spec)`` with a :class:`gift.core.robots.RobotSpec` whose ``name`` is
-    ``name`` (a URDF shipped in the plugin's package, base and end-effector frames, home configuration)."""
+    """Register robot arms: ``register(spec)`` with a :class:`gift.core.robots.RobotSpec` (a URDF shipped in the
+    plugin's package, base and end-effector frames, home configuration), under ``spec.name``."""
 
 
 @hookspec

@@ -102,11 +102,12 @@ def test_demo_runs_end_to_end_on_the_third_party_robot(fresh_env, tmp_path):
     help_text = fresh_env.run_py("-m", "gift.cli", "demo", "--help").stdout
     assert "ur5e" in help_text.split("--robot", 1)[1].split("\n", 1)[0]  # the choices come from the registry
     out_dir = tmp_path / "demo-ur5e"
-    proc = fresh_env.run_py("-m", "gift.cli", "demo", "--robot", "ur5e", "--quiet", "--out", str(out_dir),
+    proc = fresh_env.run_py("-m", "gift.cli", "-q", "demo", "--robot", "ur5e", "--out", str(out_dir),
                             timeout=3600)  # 514 CPU-s from an empty cache; slower on a busy machine
     lines = proc.stdout.strip().splitlines()
     assert lines[0].startswith("intent 'art_supplies': inferred -> ")
-    rows = {ln.split()[0]: ln.split()[1:] for ln in lines[2:-1]}
+    header = next(i for i, ln in enumerate(lines) if ln.split()[:1] == ["kernel"])
+    rows = {ln.split()[0]: ln.split()[1:] for ln in lines[header + 1:-1]}
     assert set(rows) == {"vision", "language", "gift-prob", "oracle-labels"}, proc.stdout
     for name, values in rows.items():
         assert 0.0 <= float(values[0]) <= 1.0, (name, values)

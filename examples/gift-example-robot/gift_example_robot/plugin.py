@@ -7,4 +7,4 @@ import gift
 def gift_register_robots(register):
     from gift_example_robot.robot import UR5E
 
-    register(UR5E.name, UR5E)
+    register(UR5E)  # registered under UR5E.name

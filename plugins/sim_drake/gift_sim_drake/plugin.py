@@ -16,11 +16,12 @@ from gift.plugins.hookspecs import hookimpl
 TABLETOP_FAMILIES = ("pack_backpack", "store_drawer", "sweep_spill", "place_mug")
 
 
-def drake_simulator(robot: str, **options):
-    """A :class:`gift_sim_drake.simulator.DrakeSimulator` of ``robot`` (``options``: ``render_cache_dir``)."""
+def drake_simulator(robot: str, render_cache_dir: str | None = None):
+    """A :class:`gift_sim_drake.simulator.DrakeSimulator` of ``robot`` (renders cached in ``render_cache_dir``,
+    default ``$GIFT_CACHE_DIR/renders``)."""
     from gift_sim_drake.simulator import DrakeSimulator
 
-    return DrakeSimulator(robot, **options)
+    return DrakeSimulator(robot, render_cache_dir=render_cache_dir)
 
 
 def tabletop_family(task: str):
@@ -34,8 +35,8 @@ def tabletop_family(task: str):
 def gift_register_robots(register):
     from gift_sim_drake.robots import ROBOTS  # numpy and the URDF reader only; no Drake
 
-    for name, spec in ROBOTS.items():
-        register(name, spec)
+    for spec in ROBOTS.values():
+        register(spec)  # under spec.name
 
 
 @hookimpl
