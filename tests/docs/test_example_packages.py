@@ -103,7 +103,7 @@ def test_demo_runs_end_to_end_on_the_third_party_robot(fresh_env, tmp_path):
     assert "ur5e" in help_text.split("--robot", 1)[1].split("\n", 1)[0]  # the choices come from the registry
     out_dir = tmp_path / "demo-ur5e"
     proc = fresh_env.run_py("-m", "gift.cli", "-q", "demo", "--robot", "ur5e", "--out", str(out_dir),
-                            timeout=3600)  # 514 CPU-s from an empty cache; slower on a busy machine
+                            timeout=3600)  # 667 CPU-s from an empty cache; slower on a busy machine
     lines = proc.stdout.strip().splitlines()
     assert lines[0].startswith("intent 'art_supplies': inferred -> ")
     header = next(i for i, ln in enumerate(lines) if ln.split()[:1] == ["kernel"])
