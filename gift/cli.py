@@ -17,7 +17,7 @@ from gift.plugins.manager import KINDS, get_manager
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
     manager = get_manager()
-    comps = [c for c in manager.components() if c.kind != "command" or args.all]
+    comps = [c for c in manager.components() if c.kind not in ("command", "doctor_check") or args.all]
     if args.json:
         print(json.dumps({"components": [c.as_dict() for c in comps],
                           "failed_plugins": manager.failed}, indent=2))
@@ -115,8 +115,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plugins", help="list every registered component by kind, with its distribution",
                        parents=[common])
     p.add_argument("--json", action="store_true", help="machine-readable output")
-    p.add_argument("--all", action="store_true", help="include CLI subcommands contributed by plugins")
+    p.add_argument("--all", action="store_true", help="include CLI subcommands and doctor checks of plugins")
     p.set_defaults(run=_cmd_plugins)
+    from gift import doctor
+
+    d = sub.add_parser("doctor", help="check the install; print what is missing with the command that fixes it",
+                       description=doctor.__doc__.splitlines()[0], parents=[common])
+    doctor.configure(d)
+    d.set_defaults(run=doctor.run)
     for comp in get_manager().components("command"):
         sp = sub.add_parser(comp.name, help=comp.description or None,
                             description=comp.description or None, parents=[common])

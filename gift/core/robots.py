@@ -66,7 +66,8 @@ class RobotSpec:
     - ``rest``: the home configuration (rad), one value per movable joint of the chain ``base_link ->
       ee_link``, in chain order; every trajectory starts near it. Its length is the arm's DoF.
     - ``mount``: pose of ``base_link`` in the world, ``(x, y, z, roll, pitch, yaw)`` in m and rad (default:
-      at the origin on the table top, URDF x axis pointing over the table).
+      at the origin on the table top, URDF x axis pointing over the table). Scenes are laid out around the
+      origin, so keep the first joint's axis there (x = y = 0); height and angles are free.
     - ``description``: one line for ``gift plugins``.
     """
 

@@ -128,3 +128,9 @@ def gift_register_suites(register: Register) -> None:
 @hookspec
 def gift_register_commands(register: RegisterCommand) -> None:
     """Register ``gift`` CLI subcommands."""
+
+
+@hookspec
+def gift_register_doctor_checks(register: Register) -> None:
+    """Register checks of what the plugin needs, run by ``gift doctor``: ``register(name, check)`` where
+    ``check(quick=False)`` returns a :class:`gift.doctor.Check` or a list of them."""

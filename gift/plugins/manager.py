@@ -43,6 +43,7 @@ KINDS: dict[str, str] = {
     "executor": "gift_register_executors",
     "suite": "gift_register_suites",
     "command": "gift_register_commands",
+    "doctor_check": "gift_register_doctor_checks",
 }
 
 BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators")
@@ -129,6 +130,8 @@ class GiftPluginManager:
         self._registry: dict[str, dict[str, Component]] = {k: {} for k in KINDS}
         self._distribution: dict[str, str] = {}
         self.failed: dict[str, str] = {}
+        #: plugin name -> its distribution, for the plugins in :attr:`failed`
+        self.failed_distributions: dict[str, str] = {}
         self._loaded = False
 
     # -------------------------------------------------------------------- loading
@@ -162,6 +165,7 @@ class GiftPluginManager:
                 plugin = ep.load()
             except Exception as e:  # noqa: BLE001 - any import failure of a third-party plugin
                 self.failed[ep.name] = f"{type(e).__name__}: {e}"
+                self.failed_distributions[ep.name] = dist
                 warnings.warn(f"gift plugin {ep.name!r} (distribution {dist!r}, {ep.value}) failed to import and "
                               f"was skipped: {type(e).__name__}: {e}", PluginWarning, stacklevel=2)
                 continue
@@ -186,6 +190,7 @@ class GiftPluginManager:
                     raise
                 except Exception as e:  # noqa: BLE001
                     self.failed[plugin_name] = f"{hook_name}: {type(e).__name__}: {e}"
+                    self.failed_distributions[plugin_name] = self._distribution.get(plugin_name, "?")
                     warnings.warn(f"gift plugin {plugin_name!r}: hook {hook_name} raised {type(e).__name__}: {e}; "
                                   f"its remaining registrations were skipped", PluginWarning, stacklevel=2)
 

@@ -26,6 +26,11 @@ from gift.plugins.hookspecs import hookimpl
 PROXIMITY_SCALE = 0.15
 EE_HEIGHT_SCALE = 0.5
 EE_SPEED_SCALE = 0.05
+#: place_mug: weight of the mug's height (``ee_height`` summed over time) in the simulated human's reward; at
+#: 1, a step with the mug 0.5 m up costs as much as a step with it touching a relevant object.
+MUG_HEIGHT_COST = 1.0
+#: place_mug: weight of the path length (``ee_speed`` summed over time) in the simulated human's reward.
+MUG_PATH_COST = 0.1
 
 EE_FEATURES = (
     FeatureSpec("ee_height", "height of the robot's end effector above the table (1 = 0.5 m or higher)",
@@ -75,7 +80,19 @@ class StoreDrawer(_ContainerTask):
 
 
 class PlaceMug(Task):
-    """Carry a full mug to a goal, keeping it away from the objects the human cares about."""
+    """Carry a full mug to a goal, keeping it away from the objects the human cares about.
+
+    The simulated human (:meth:`ground_truth_reward`) carries a full mug the way a person does: low, and
+    steering around the relevant objects. Its reward, per trajectory, is minus
+
+    - the mug's closeness to the relevant objects (their ``mug_proximity_to_<object>``), summed over time;
+    - :data:`MUG_HEIGHT_COST` times the mug's height (``ee_height``) summed over time: lifting a full mug is
+      effort and risks a spill, so a carry raised over the whole table is not worth it;
+    - :data:`MUG_PATH_COST` times the path length (``ee_speed`` summed over time).
+
+    Irrelevant objects cost nothing: the human passes them as close as the route around the relevant ones
+    takes it.
+    """
 
     name = "place_mug"
     description = "The robot arm carries a mug full of coffee across a table with objects on it to a goal spot."
@@ -86,10 +103,10 @@ class PlaceMug(Task):
 
     def ground_truth_reward(self, features: FeatureBatch, relevant: Sequence[str]) -> np.ndarray:
         rel = set(relevant)
-        near = np.array([1.0 if s.semantic and s.subject in rel else 0.0 for s in features.specs])
-        speed = np.array([1.0 if s.name == "ee_speed" else 0.0 for s in features.specs])
-        # closeness to relevant objects summed over time, plus a small cost of path length
-        return -(features.values @ near).sum(axis=1) - 0.1 * (features.values @ speed).sum(axis=1)
+        w = np.array([1.0 if s.semantic and s.subject in rel else
+                      MUG_HEIGHT_COST if s.name == "ee_height" else MUG_PATH_COST if s.name == "ee_speed" else 0.0
+                      for s in features.specs])
+        return -(features.values @ w).sum(axis=1)
 
 
 class SweepSpill(Task):

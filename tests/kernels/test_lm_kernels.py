@@ -429,7 +429,7 @@ def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_
     intent = Intent(text="The person wanted to pick up the sketchbook.", source="inferred",
                     motivations=(gift.Motivation("The person wanted to pick up the sketchbook."),
                                  gift.Motivation("The person wanted to tidy the table.")))
-    k = GiftProbKernel(lm=lm, combine="none", candidates="all")
+    k = GiftProbKernel(lm=lm, combine="none", candidates="all", select="margin")
     assert k.candidate_goals(intent, ("paintbrush", "sketchbook")) == [intent.text, "The person wanted to tidy the table.",
                                                                         None]
     rs = k.score(TEST, TRAIN, intent, ("paintbrush", "sketchbook"))
@@ -450,6 +450,11 @@ def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_
     assert objects_only and objects_only[0].endswith("Which kind of objects is the goal about?")
     with pytest.raises(GiftError, match="candidates"):
         GiftProbKernel(candidates="some")
+    # select="first" (the default): the first candidate with the best AUC, in order: here the intent's text
+    lm.calls.clear()
+    first = GiftProbKernel(lm=lm, combine="none", candidates="all").score(TEST, TRAIN, intent, ("paintbrush",
+                                                                                              "sketchbook"))
+    assert first.details["category"] == "sketchbooks" and first.details["candidates"][0]["chosen"]
 
 
 def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_suite():

@@ -140,3 +140,22 @@ def test_continuous_joints_have_no_limits_in_numpy_and_on_the_plant(tmp_path):
     q = np.asarray(spinning.rest) + [0, 0, 0, 0, 0, 0, 7.0]  # beyond 2 pi
     model.set_state(q, {})
     assert np.abs(model.ee_position() - kin.fk(q)[0]).max() < 1e-9
+
+
+@pytest.mark.parametrize("robot", sorted(ARMS))
+def test_reach_from_the_kinematics_agrees_with_drake_ik(specs, robot):
+    """The reach the layouts keep objects within: inside it (less the layout's margin) Drake's IK reaches the
+    point pointing down, in several directions; 3 cm beyond it, it does not."""
+    from gift_sim_drake.scenes import REACH_MARGIN
+
+    spec = specs[robot]
+    heights = np.array([0.05, 0.25, 0.35])
+    reach = arm_kinematics(spec).reach_pointing_down(heights, np.asarray(spec.rest))
+    assert (reach > 0.5).all() and (np.diff(reach) <= 0.01).all()  # further down, not less far
+    ik = drake_ik(spec)
+    for z, r in zip(heights, reach):
+        for angle in (-0.6, 0.0, 0.8):
+            direction = np.array([np.cos(angle), np.sin(angle)])
+            ik.solve([*(direction * (r - REACH_MARGIN)), z], spec.rest)
+            with pytest.raises(GiftError, match="no .* configuration"):
+                ik.solve([*(direction * (r + 0.03)), z], spec.rest)

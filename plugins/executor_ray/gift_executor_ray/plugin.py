@@ -15,3 +15,14 @@ def _make_ray_executor(**options):
 def gift_register_executors(register):
     register("ray", _make_ray_executor,
              description="Ray tasks on a cluster (address=...) or on a local Ray instance it starts")
+
+
+def _check_ray(quick: bool = False):
+    from gift.doctor import check_import, pip_fix
+
+    return check_import("ray", ["ray"], fix=pip_fix("-e plugins/executor_ray"), what="the ray executor")
+
+
+@hookimpl
+def gift_register_doctor_checks(register):
+    register("ray", _check_ray, description="ray imports (the ray executor)")

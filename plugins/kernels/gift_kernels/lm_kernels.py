@@ -233,6 +233,7 @@ STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
+SELECT = ("first", "margin")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -287,7 +288,8 @@ class GiftProbKernel(RelevanceKernel):
                  axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
-                 constrained: bool = True, candidates: str = "text", candidate_terms: bool = False) -> None:
+                 constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
+                 select: str = "first") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -304,6 +306,9 @@ class GiftProbKernel(RelevanceKernel):
             raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
         if candidates not in CANDIDATES:
             raise GiftError(f"gift-prob: candidates must be one of {CANDIDATES}, got {candidates!r}")
+        if select not in SELECT:
+            raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
+        self.select = select
         #: ``"text"``: the intent's text names the category; ``"all"``: every motivation and the objects alone
         #: are candidates, and the training objects verify them (:meth:`candidate_goals`).
         self.candidates = candidates
@@ -505,6 +510,16 @@ class GiftProbKernel(RelevanceKernel):
         margin = float(pos.mean() - neg.mean()) if pos.size and neg.size else float("nan")
         return {"auc": auc, "margin": margin}
 
+    def _select(self, cands: Sequence[dict[str, Any]]) -> int:
+        """The candidate to keep: ``select="first"``, the first (in :meth:`candidate_goals` order: the intent's
+        text, its other motivations, the objects alone) whose leave-one-out AUC is the best of all;
+        ``"margin"``: the best AUC, ties broken by the larger margin. Measured in docs/results/front_half.md."""
+        aucs = [np.nan_to_num(c["auc"], nan=-1.0) for c in cands]
+        top = max(aucs)
+        if self.select == "first":
+            return next(k for k, a in enumerate(aucs) if a >= top - 1e-12)
+        return max(range(len(cands)), key=lambda k: (aucs[k], np.nan_to_num(cands[k]["margin"], nan=-np.inf), -k))
+
     def score(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None = None,
               relevant_train: Sequence[str] = ()) -> RelevanceScores:
         """One pass over a scene: relevance of the test objects ``[n_test]`` and, leave-one-out, of the
@@ -532,8 +547,7 @@ class GiftProbKernel(RelevanceKernel):
                 lo_train = self.log_odds(train, intent, cats)
                 cands.append({"goal": goal, "category": self.category(goal, *self._split(train, rel)),
                               "lo_train": lo_train, **self._verify(lo_train, rel, usable)})
-            best = max(range(len(cands)), key=lambda k: (np.nan_to_num(cands[k]["auc"], nan=-1.0),
-                                                         np.nan_to_num(cands[k]["margin"], nan=-np.inf), -k))
+            best = self._select(cands)
             chosen = cands[best]
             lo = np.concatenate([self.log_odds(test, intent, [chosen["category"]] * len(test)), chosen["lo_train"]])
             details["category"] = chosen["category"]

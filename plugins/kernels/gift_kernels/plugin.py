@@ -35,3 +35,10 @@ def gift_register_commands(register):
              configure=cli.configure_align)
     register("infer-intent", intent_cli.run_infer_intent, help="infer the intent (Calls 1-2) from saved "
              "demonstration pairs", configure=intent_cli.configure_infer_intent)
+
+
+@hookimpl
+def gift_register_doctor_checks(register):
+    from gift_kernels import doctor
+
+    register("embedding models", doctor.check_embedding_models, description="torch, MiniLM, EfficientNet-Lite0")

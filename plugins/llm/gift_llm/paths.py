@@ -5,15 +5,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from gift.core.paths import cache_root
 
-def cache_root() -> Path:
-    """Root of every gift cache; ``GIFT_CACHE_DIR`` overrides the platform's user cache directory."""
-    env = os.environ.get("GIFT_CACHE_DIR", "").strip()
-    if env:
-        return Path(env).expanduser()
-    import platformdirs
-
-    return Path(platformdirs.user_cache_dir("gift", appauthor=False))
+__all__ = ["cache_root", "lm_cache_path", "lm_cache_url", "models_dir"]
 
 
 def models_dir() -> Path:

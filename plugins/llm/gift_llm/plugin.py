@@ -43,6 +43,16 @@ def gift_register_lm_backends(register):
 
 
 @hookimpl
+def gift_register_doctor_checks(register):
+    from gift_llm import doctor
+
+    register("embedded model", doctor.check_embedded_model, description="the embedded GGUF: size and sha256")
+    register("llama.cpp backend", doctor.check_llamacpp, description="llama-cpp-python imports")
+    register("optional LM backends", doctor.check_optional_backends,
+             description="litellm, llama.cpp's HTTP server, the Redis client")
+
+
+@hookimpl
 def gift_resolve_lm(spec, options):
     from gift_llm.resolve import resolve_lm
 

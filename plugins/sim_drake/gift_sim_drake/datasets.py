@@ -14,6 +14,7 @@ import numpy as np
 
 from gift.core.data import FeatureBatch, FeatureSpec, ObjectSpec, TrajectoryBatch
 from gift.core.errors import GiftError
+from gift.core.paths import cache_root
 from gift.core.serialization import to_jsonable
 
 FORMAT_VERSION = 1
@@ -106,12 +107,7 @@ def generate_or_load(simulator, task: str, objects: Sequence[ObjectSpec], releva
 
     objects = as_object_specs(objects)
     if cache_dir is None:
-        root = os.environ.get("GIFT_CACHE_DIR")
-        if not root:
-            import platformdirs
-
-            root = platformdirs.user_cache_dir("gift")
-        cache_dir = Path(root) / "datasets"
+        cache_dir = cache_root() / "datasets"
     from gift_sim_drake.robots import robot_fingerprint
 
     key = dataset_key(simulator.robot.name, task, objects, relevant, scene_seed, generator, n, seed,

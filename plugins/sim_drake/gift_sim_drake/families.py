@@ -23,7 +23,7 @@ docs/tutorials/task-plugin.md.
 from __future__ import annotations
 
 import abc
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
 import attrs
@@ -36,6 +36,9 @@ from gift.core.errors import GiftError, UnknownComponentError
 PREFIX = "drake/"
 #: States per trajectory (steps 0..60).
 N_STEPS = 61
+#: An arm's reach: heights ``[H]`` (m) -> the largest distance ``[H]`` (m) from the base's vertical axis at which
+#: the tool centre point gets there with the gripper pointing down (:meth:`DrakeSimulator.reach`).
+Reach = Callable[[np.ndarray], np.ndarray]
 
 
 @attrs.frozen
@@ -100,8 +103,11 @@ class MotionFamily(abc.ABC):
     carried_landmark: ClassVar[Appearance | None] = None
 
     @abc.abstractmethod
-    def layout(self, objects: Sequence[ObjectSpec], relevant: Sequence[str], seed: int) -> Scene:
-        """A randomised scene of ``objects`` (deterministic in ``seed``); raise
+    def layout(self, objects: Sequence[ObjectSpec], relevant: Sequence[str], seed: int,
+               reach: Reach | None = None) -> Scene:
+        """A randomised scene of ``objects`` (deterministic in ``seed``) for an arm with this ``reach`` (None:
+        unknown; keep what the arm must reach within it, e.g. with
+        :func:`gift_sim_drake.scenes.place_apart`'s ``fits``); raise
         :class:`~gift.core.errors.PlacementError` when they do not fit."""
 
     @abc.abstractmethod

@@ -207,3 +207,28 @@ class ArmKinematics:
         _, _, pos, rot = self.frames(q)
         err = np.linalg.norm(targets - pos, axis=-1) + np.linalg.norm(down - rot[..., :, 2], axis=-1)
         return q, err
+
+    def reach_pointing_down(self, heights: np.ndarray, start: np.ndarray, *, step: float = 0.01,
+                            tol: float = 1e-4) -> np.ndarray:
+        """How far the arm reaches with the gripper pointing down: per height ``[H]`` (m), the largest distance
+        (m) from the base's vertical axis at which the tool centre point gets there, ``[H]``.
+
+        Continuation along +x: from the posture ``start`` ``[dof]`` (e.g. the rest posture), local IK
+        (:meth:`solve_pointing_down`) reaches 0.3 m out, then follows the target outward in ``step`` increments
+        until the residual exceeds ``tol`` (so the answer is at most ``step`` short). Assumes the first joint turns
+        the arm about the vertical axis through the base at the origin, so the reach is the same in every
+        direction; 0 where even 0.3 m is out of reach.
+        """
+        heights = np.atleast_1d(np.asarray(heights, dtype=float))
+        q = np.tile(np.asarray(start, dtype=float), (len(heights), 1))
+        reach = np.zeros(len(heights))
+        ok = np.ones(len(heights), dtype=bool)
+        for i, r in enumerate(np.arange(0.3, 2.0, step)):
+            targets = np.column_stack([np.full(len(heights), r), np.zeros(len(heights)), heights])
+            moved, err = self.solve_pointing_down(q, targets, iterations=100 if i == 0 else 30, tol=tol / 10)
+            ok &= err < tol
+            q = np.where(ok[:, None], moved, q)
+            reach = np.where(ok, r, reach)
+            if not ok.any():
+                break
+        return reach

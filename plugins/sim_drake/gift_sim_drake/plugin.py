@@ -32,6 +32,14 @@ def tabletop_family(task: str):
 
 
 @hookimpl
+def gift_register_doctor_checks(register):
+    from gift_sim_drake import doctor
+
+    register("drake", doctor.check_drake, description="pydrake imports")
+    register("EGL", doctor.check_egl, description="EGL libraries for Drake's headless renders")
+
+
+@hookimpl
 def gift_register_robots(register):
     from gift_sim_drake.robots import ROBOTS  # numpy and the URDF reader only; no Drake
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from gift.core.data import Appearance, ObjectSpec
 from gift.core.errors import GiftError
+from gift.core.paths import cache_root
 
 logging.getLogger("drake").setLevel(logging.ERROR)
 
@@ -31,12 +32,7 @@ _LOCK = threading.Lock()
 
 def render_cache_dir(cache_dir: str | os.PathLike | None = None) -> Path:
     if cache_dir is None:
-        root = os.environ.get("GIFT_CACHE_DIR")
-        if not root:
-            import platformdirs
-
-            root = platformdirs.user_cache_dir("gift")
-        cache_dir = Path(root) / "renders"
+        cache_dir = cache_root() / "renders"
     path = Path(cache_dir)
     path.mkdir(parents=True, exist_ok=True)
     return path

@@ -5,6 +5,7 @@ renders)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -31,6 +32,16 @@ def as_object_specs(objects: Sequence[ObjectSpec | str]) -> tuple[ObjectSpec, ..
     return tuple(out)
 
 
+#: Heights (m) at which an arm's reach is computed; :meth:`DrakeSimulator.reach` interpolates between them.
+REACH_HEIGHTS = np.arange(0.0, 0.81, 0.05)
+
+
+@lru_cache(maxsize=None)
+def _reach_curve(robot: RobotSpec) -> np.ndarray:
+    """The arm's reach with the gripper pointing down at :data:`REACH_HEIGHTS`, from its kinematics (m)."""
+    return arm_kinematics(robot).reach_pointing_down(REACH_HEIGHTS, np.asarray(robot.rest))
+
+
 class DrakeSimulator(Simulator):
     """Tabletop scenes of the task families for one arm, on Drake.
 
@@ -38,7 +49,8 @@ class DrakeSimulator(Simulator):
     (``gift.get_simulator("drake-<robot>")`` builds it for a registered one).
 
     - ``make_scene(task, objects, relevant, seed)``: a randomised layout from the family's motion family
-      (:mod:`gift_sim_drake.families`; the paper's four in :mod:`gift_sim_drake.tabletop`);
+      (:mod:`gift_sim_drake.families`; the paper's four in :mod:`gift_sim_drake.tabletop`), objects to be
+      picked within this arm's :meth:`reach`;
       ``scene.landmarks`` holds the family's landmarks (``backpack``/``drawer``: the place point inside the
       container; ``spill``: the spill's centre on the table; ``mug``: the mug's start, and ``mug_goal``).
     - ``generate(scene, generator, n, seed)``: ``generator`` in ``("preferred", "default", "random")``
@@ -65,7 +77,13 @@ class DrakeSimulator(Simulator):
     def make_scene(self, task: str, objects: Sequence[ObjectSpec | str], relevant: Sequence[str] = (),
                    seed: int = 0) -> Scene:
         family = resolve_task(task)  # unknown names: UnknownComponentError listing the registered families
-        return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed))
+        return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed), reach=self.reach)
+
+    def reach(self, heights: np.ndarray) -> np.ndarray:
+        """How far this arm reaches with the gripper pointing down: per height ``[H]`` (m), the largest distance
+        ``[H]`` (m) from the base's vertical axis, from its kinematics
+        (:meth:`~gift_sim_drake.kinematics.ArmKinematics.reach_pointing_down`, computed once per arm)."""
+        return np.interp(np.asarray(heights, dtype=float), REACH_HEIGHTS, _reach_curve(self.robot))
 
     def generate(self, scene: Scene, generator: str = "preferred", n: int = 1, seed: int = 0) -> TrajectoryBatch:
         return self.planner.generate(scene, generator, n, seed)

@@ -12,8 +12,18 @@ Actions, each acting on one thing:
   (keyframes: pre-grasp, grasp, lift, transit, above the container, place);
 - sweep_spill: push object ``i`` sideways (towards +y or -y) across the table
   (pre-contact, contact, mid-push, end of push, retreat);
-- place_mug: carry the mug from its start to its goal along the straight line or one of several
-  detours (start, lift, three via points, above the goal, place).
+- place_mug: carry the mug from its start to its goal (start, lift, three via points, above the goal,
+  place): low (:data:`CARRY_HEIGHT`), passing each via point on the straight line or
+  :data:`MUG_STEER` to either side of it (27 routes: straight, shifted to one side, bends and S-curves
+  around single objects), or raised over the table (:data:`MUG_RAISED`).
+
+Layouts: pack_backpack / store_drawer put the objects anywhere on the table beside the container, and,
+given the arm's ``reach``, only where it can pick them (the lift above each one within reach, with a
+margin); sweep_spill puts them in slots on either side of the spill; place_mug beside the mug's straight
+path, on both sides of it and :data:`MUG_LATERAL` away from it. When a place_mug scene has both kinds, the
+relevant objects lie on one side and the irrelevant ones on the other, so that steering around the
+relevant objects (what the simulated human does, :class:`gift.tasks.PlaceMug`) takes the mug towards the
+others rather than away from every object at once; otherwise the objects are split evenly between the sides.
 
 Each family is a :class:`gift_sim_drake.families.MotionFamily`, registered as ``drake/<family>`` by
 :mod:`gift_sim_drake.plugin`.
@@ -21,39 +31,72 @@ Each family is a :class:`gift_sim_drake.families.MotionFamily`, registered as ``
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 import numpy as np
 
 from gift.core.data import ObjectSpec, Scene
 from gift.core.errors import GiftError
-from gift_sim_drake.families import ActionSet, MotionFamily
+from gift_sim_drake.families import ActionSet, MotionFamily, Reach
 from gift_sim_drake.plant import CONTAINERS, MUG, footprint_radius, half_height
-from gift_sim_drake.scenes import nearest_object, place_apart
+from gift_sim_drake.scenes import REACH_MARGIN, nearest_object, place_apart
 
 #: Height (m) of the place point inside a container above the table.
 PLACE_HEIGHT = {"backpack": 0.09, "drawer": 0.07}
 MUG_CENTER_Z = MUG.size[1] / 2
+#: place_mug: distance (m) of an object's centre from the mug's straight path, drawn uniformly in this range.
+#: At least half the steer of the low carries (:data:`MUG_STEER`), so that a carry steered towards an object's
+#: side passes closer to it than the straight path, not round its far side.
+MUG_LATERAL = (0.08, 0.14)
+#: The most the pick motion's perturbation raises the lift (m; :meth:`ContainerFamily.perturb`).
+LIFT_JITTER = 0.05
 PUSH_LENGTH = 0.24
 CARRY_HEIGHT = 0.18
-#: place_mug actions: (lateral offset of the middle via point in m, towards +x; height of the via points in m).
-MUG_DETOURS = ((0.0, CARRY_HEIGHT), (-0.1, CARRY_HEIGHT), (0.12, CARRY_HEIGHT), (0.2, CARRY_HEIGHT),
-               (0.0, 0.38), (-0.1, 0.3), (0.15, 0.3))
+#: place_mug via points, as fractions of the way from the mug's start to its goal.
+MUG_VIAS = (0.25, 0.5, 0.75)
+#: place_mug low carries: at each via point the mug passes on the straight line or this far (m) to either side.
+MUG_STEER = 0.15
+#: place_mug raised carries: (lateral offset of the middle via point in m, towards +x; height of the via points in m).
+MUG_RAISED = ((0.0, 0.38), (-0.1, 0.3), (0.15, 0.3))
+
+
+def lift_height(center_z: float) -> float:
+    """Height (m) to which picking an object whose centre is at ``center_z`` lifts the gripper: 0.25 m, or 0.15 m
+    above a tall object's centre (:meth:`ContainerFamily.actions`)."""
+    return max(center_z + 0.15, 0.25)
+
+
+def mug_routes() -> tuple[tuple[tuple[float, ...], float], ...]:
+    """place_mug routes: ``((lateral offset at each of MUG_VIAS in m, towards +x), height in m)``; the first is
+    the straight low carry (the nominal one), then the other low carries, then the raised ones."""
+    sides = (0.0, -MUG_STEER, MUG_STEER)
+    low = [(offsets, CARRY_HEIGHT) for offsets in itertools.product(sides, repeat=len(MUG_VIAS))]
+    raised = [(tuple(offset * np.sin(np.pi * f) for f in MUG_VIAS), height) for offset, height in MUG_RAISED]
+    return tuple(low + raised)
+
+
+def _route_label(offsets: tuple[float, ...], height: float) -> str:
+    if height == CARRY_HEIGHT and not any(offsets):
+        return "carry the mug straight to the goal"
+    where = "low" if height == CARRY_HEIGHT else f"raised to {height:.2f} m"
+    return f"carry the mug {where}, passing the via points at {'/'.join(f'{o:+.2f}' for o in offsets)} m sideways"
 
 
 class _Tabletop(MotionFamily):
     """Shared layout steps: the rng, footprints, then the nominal object swapped for an irrelevant one."""
 
-    def layout(self, objects: Sequence[ObjectSpec], relevant: Sequence[str], seed: int) -> Scene:
+    def layout(self, objects: Sequence[ObjectSpec], relevant: Sequence[str], seed: int,
+               reach: Reach | None = None) -> Scene:
         if not objects:
             raise GiftError(f"a {self.task} scene needs at least one object")
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(0x5CE,)))
         radii = np.array([footprint_radius(o.appearance) for o in objects])
         heights = np.array([half_height(o.appearance) for o in objects])
-        landmarks, xy = self._place(rng, radii)
+        rel = np.array([o.name in set(relevant) for o in objects])
+        landmarks, xy = self._place(rng, radii, heights, rel, reach)
         positions = np.column_stack([xy, heights])
         # the nominal controller's object should be an irrelevant one when the scene has both kinds
-        rel = np.array([o.name in set(relevant) for o in objects])
         k = self.nominal_object(positions, landmarks)
         if k >= 0 and rel[k] and not rel.all():
             others = np.flatnonzero(~rel)
@@ -62,8 +105,9 @@ class _Tabletop(MotionFamily):
         return Scene(task=self.task, objects=tuple(objects), relevant=frozenset(relevant), positions=positions,
                      landmarks=landmarks, seed=int(seed))
 
-    def _place(self, rng: np.random.Generator, radii: np.ndarray) -> tuple[dict, np.ndarray]:
-        """``(landmarks, xy [n, 2])``."""
+    def _place(self, rng: np.random.Generator, radii: np.ndarray, heights: np.ndarray, rel: np.ndarray,
+               reach: Reach | None) -> tuple[dict, np.ndarray]:
+        """``(landmarks, xy [n, 2])`` for objects of footprint ``radii``, centre ``heights`` and relevance ``rel``."""
         raise NotImplementedError
 
     def nominal_object(self, positions: np.ndarray, landmarks: dict) -> int:
@@ -79,14 +123,21 @@ class ContainerFamily(_Tabletop):
             raise GiftError(f"unknown container {container!r}; containers: {sorted(CONTAINERS)}")
         self.task, self.landmark = task, container
 
-    def _place(self, rng, radii):
+    def _place(self, rng, radii, heights, rel, reach):
         side = rng.choice([-1.0, 1.0])
         c = (0.42 + rng.uniform(-0.03, 0.03), side * (0.42 + rng.uniform(-0.03, 0.03)), PLACE_HEIGHT[self.landmark])
 
         def sample(r):
             return np.array([r.uniform(0.28, 0.62), side * r.uniform(-0.45, 0.14)])
 
-        return {self.landmark: c}, place_apart(rng, radii, sample, f"{self.task} table")
+        fits = None
+        if reach is not None:  # the lift above each object (+ its perturbation) within reach, less the margin
+            limit = np.asarray(reach(np.array([lift_height(z) + LIFT_JITTER for z in heights])), dtype=float)
+
+            def fits(i, p):
+                return float(np.hypot(*p)) <= limit[i] - REACH_MARGIN
+
+        return {self.landmark: c}, place_apart(rng, radii, sample, f"{self.task} table", fits=fits)
 
     def actions(self, scene: Scene) -> ActionSet:
         pos = np.asarray(scene.positions)
@@ -95,7 +146,7 @@ class ContainerFamily(_Tabletop):
         above = np.array([c[0], c[1], CONTAINERS[mark]["height"] + 0.08])
         targets = []
         for p in pos:
-            lift = np.array([p[0], p[1], max(p[2] + 0.15, 0.25)])
+            lift = np.array([p[0], p[1], lift_height(p[2])])
             transit = np.array([(p[0] + c[0]) / 2, (p[1] + c[1]) / 2, max(lift[2], above[2]) + 0.03])
             grasp = np.array([p[0], p[1], max(p[2], 0.02)])  # thin objects: keep the fingers off the table
             targets.append([grasp + [0, 0, 0.12], grasp, lift, transit, above, c])
@@ -122,7 +173,7 @@ class SweepSpill(_Tabletop):
     task = "sweep_spill"
     landmark = "spill"
 
-    def _place(self, rng, radii):
+    def _place(self, rng, radii, heights, rel, reach):
         n = len(radii)
         s = np.array([0.42 + rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)])
         landmarks = {"spill": (float(s[0]), float(s[1]), 0.0)}
@@ -173,7 +224,7 @@ class PlaceMug(_Tabletop):
     required_landmarks = ("mug", "mug_goal")
     carried_landmark = MUG
 
-    def _place(self, rng, radii):
+    def _place(self, rng, radii, heights, rel, reach):
         n = len(radii)
         sy = rng.choice([-1.0, 1.0])
         start = np.array([0.45 + rng.uniform(-0.03, 0.03), sy * (-0.30 + rng.uniform(-0.03, 0.03))])
@@ -182,7 +233,11 @@ class PlaceMug(_Tabletop):
                      "mug_goal": (float(goal[0]), float(goal[1]), MUG_CENTER_Z)}
         along = rng.permutation(np.linspace(0.22, 0.78, n)) if n > 1 else np.array([0.5])
         normal = np.array([-(goal - start)[1], (goal - start)[0]]) / np.linalg.norm(goal - start)
-        lateral = rng.uniform(-0.05, 0.05, size=n) + np.where(np.arange(n) % 2, 1.0, -1.0) * 0.02 * (n > 5)
+        if rel.any() and not rel.all():
+            sides = np.where(rel, 1.0, -1.0) * rng.choice([-1.0, 1.0])
+        else:
+            sides = rng.permutation(np.resize([1.0, -1.0], n))
+        lateral = sides * rng.uniform(*MUG_LATERAL, size=n)
         return landmarks, start + along[:, None] * (goal - start) + lateral[:, None] * normal
 
     def nominal_object(self, positions, landmarks) -> int:
@@ -194,17 +249,17 @@ class PlaceMug(_Tabletop):
         line = goal - start
         normal = np.array([-line[1], line[0], 0.0]) / np.linalg.norm(line[:2])
         normal *= np.sign(normal[0]) or 1.0  # positive offsets point away from the robot (+x)
+        lift = np.array([start[0], start[1], CARRY_HEIGHT])
+        above = np.array([goal[0], goal[1], CARRY_HEIGHT])
+        routes = mug_routes()
         targets, labels = [], []
-        for offset, height in MUG_DETOURS:
-            vias = [start + f * line + np.sin(np.pi * f) * offset * normal for f in (0.25, 0.5, 0.75)]
+        for offsets, height in routes:
+            vias = [start + f * line + offset * normal for f, offset in zip(MUG_VIAS, offsets)]
             vias = [np.array([v[0], v[1], height]) for v in vias]
-            lift = np.array([start[0], start[1], CARRY_HEIGHT])
-            above = np.array([goal[0], goal[1], CARRY_HEIGHT])
             targets.append([start, lift, *vias, above, goal])
-            labels.append("carry the mug straight to the goal" if offset == 0 and height == CARRY_HEIGHT else
-                          f"carry the mug with a detour ({offset:+.2f} m sideways, {height:.2f} m high)")
-        return ActionSet(np.array(targets), (0, 8, 20, 30, 40, 52, 60), np.full(len(MUG_DETOURS), -1), 0, None,
-                         False, tuple(labels), 0)
+            labels.append(_route_label(offsets, height))
+        return ActionSet(np.array(targets), (0, 8, 20, 30, 40, 52, 60), np.full(len(routes), -1), 0, None, False,
+                         tuple(labels), 0)
 
     def perturb(self, targets, acts, rng, scale):
         """Mug start and goal (+-3 cm each, blended along the keyframes) and the via points (+-2 cm)."""

@@ -86,7 +86,8 @@ def _litellm() -> Any:
     try:
         import litellm
     except ImportError as e:
-        raise LMError("litellm backend: the litellm package is not installed (bash scripts/setup.sh)") from e
+        raise LMError("litellm backend: the litellm package is not installed: pip install 'gift-llm[litellm]' "
+                      "(from a clone: bash scripts/setup.sh)") from e
     litellm.suppress_debug_info = True
     return litellm
 

@@ -14,13 +14,18 @@ instance on that file; calls to it are serialised by a lock.
 Threads: unless ``n_threads`` is given, a model uses the process's thread budget
 (:func:`default_threads`: ``$OMP_NUM_THREADS``, which the ``local`` executor sets for each worker and Ray
 sets for its tasks, else all cores), for generation and prompt evaluation alike, so the workers of a pool
-do not oversubscribe the cores.
+do not oversubscribe the cores. Within that budget, each call runs on the cores that other processes leave
+free (:class:`ThreadGovernor`): llama.cpp's threads meet at a barrier after every operation, so one
+thread that shares its core with another busy process stalls the others. On 2 cores with other work
+running, 2 threads generated 0.34 tokens/s against 5.3 for 1 thread (docs/performance.md). The thread
+count does not change a single bit of the logits (tests/llm/test_lm_llamacpp.py).
 """
 
 from __future__ import annotations
 
 import atexit
 import json
+import math
 import os
 import threading
 import time
@@ -52,6 +57,66 @@ def default_threads() -> int:
     return budget if budget > 0 else (os.cpu_count() or 1)
 
 
+def _cpu_ticks() -> tuple[int, int, int] | None:
+    """``(all CPUs' ticks, busy ticks of all CPUs, this process's ticks)`` from ``/proc`` (None elsewhere)."""
+    try:
+        with open("/proc/stat", "rb") as f:
+            fields = [int(x) for x in f.readline().split()[1:]]
+        with open("/proc/self/stat", "rb") as f:
+            own = f.read().rsplit(b")", 1)[1].split()
+    except (OSError, ValueError, IndexError):
+        return None
+    idle = fields[3] + (fields[4] if len(fields) > 4 else 0)  # idle + iowait
+    total = sum(fields[:8])  # user nice system idle iowait irq softirq steal (guest time is inside user)
+    return total, total - idle, int(own[11]) + int(own[12])  # utime + stime
+
+
+class ThreadGovernor:
+    """Threads for the next llama.cpp call: the ``budget``, less the cores other processes kept busy since
+    the previous call (measured from ``/proc/stat`` minus this process's own CPU time).
+
+    ``others >= k - 1/2`` busy cores take ``k`` threads off; at least one thread is always used. Decisions
+    are reused for calls less than ``min_interval_s`` apart (too short a window to measure); the first
+    call, when it comes sooner than that after construction, estimates ``others`` from the 1-minute load
+    average instead. Without ``/proc`` the budget is used. ``sample`` returns ``(total, busy, own)`` ticks
+    (tests pass their own).
+    """
+
+    def __init__(self, budget: int, *, min_interval_s: float = 0.25, sample=_cpu_ticks,
+                 cpus: int | None = None) -> None:
+        self.budget = max(1, int(budget))
+        self.cpus = int(cpus or os.cpu_count() or 1)
+        self.min_interval_s = float(min_interval_s)
+        self._sample = sample
+        self._last = sample()
+        self._last_t = time.monotonic()
+        self.others = 0.0  #: cores other processes kept busy in the last window
+        self.threads = self.budget
+        self._decided = False
+
+    def _decide(self, others: float) -> int:
+        self.others = max(0.0, others)
+        self.threads = max(1, min(self.budget, self.cpus - math.floor(self.others + 0.5)))
+        self._decided = True
+        return self.threads
+
+    def next_threads(self) -> int:
+        now = time.monotonic()
+        if now - self._last_t < self.min_interval_s:
+            if not self._decided and self._last is not None:
+                return self._decide(os.getloadavg()[0])
+            return self.threads
+        cur = self._sample()
+        if cur is None or self._last is None:
+            self._last, self._last_t = cur, now
+            return self.threads
+        d_total, d_busy, d_own = (c - p for c, p in zip(cur, self._last))
+        self._last, self._last_t = cur, now
+        if d_total <= 0:
+            return self.threads
+        return self._decide((d_busy - d_own) / (d_total / self.cpus))  # busy CPUs not ours, in CPUs
+
+
 def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int | None = None, n_batch: int = 512,
                seed: int = 0, verbose: bool = False) -> tuple[Any, threading.RLock]:
     """The shared ``Llama`` for ``path`` (loaded on first use) and the lock guarding it.
@@ -70,7 +135,8 @@ def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int | None = N
         try:
             from llama_cpp import Llama
         except ImportError as e:
-            raise LMError("llamacpp: llama-cpp-python is not installed (bash scripts/setup.sh installs it)") from e
+            raise LMError("llamacpp: llama-cpp-python is not installed: pip install 'gift-llm[llamacpp]' "
+                          "(from a clone: bash scripts/setup.sh)") from e
         threads = int(n_threads) if n_threads is not None else default_threads()
         if threads < 1:
             raise LMError(f"llamacpp: n_threads must be >= 1, got {n_threads!r}")
@@ -99,15 +165,16 @@ def _close_all() -> None:
 class LlamaCppLM(LMBackend):
     """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities).
 
-    ``n_threads``: CPU threads (default: the process's budget, :func:`default_threads`).
+    ``n_threads``: CPU threads (default: the process's budget, :func:`default_threads`, of which each call
+    takes the cores other processes leave free unless ``adapt_threads=False``; see :class:`ThreadGovernor`).
     """
 
     name: ClassVar[str] = "llamacpp"
     supports_choice_probabilities: ClassVar[bool] = True
 
     def __init__(self, model: str | Path | None = None, *, n_ctx: int = 4096, n_threads: int | None = None,
-                 n_batch: int = 512, seed: int = 0, reuse_prefix: bool = True, verbose: bool = False,
-                 **_ignored: Any):
+                 n_batch: int = 512, seed: int = 0, reuse_prefix: bool = True, adapt_threads: bool = True,
+                 verbose: bool = False, **_ignored: Any):
         if model is None:
             from gift_llm.embedded import embedded_model_path
 
@@ -122,6 +189,15 @@ class LlamaCppLM(LMBackend):
         #: Prompt tokens taken from the KV cache in the last :meth:`next_token_logits` call.
         self.last_reused_tokens = 0
         self._opts = dict(n_ctx=self.n_ctx, n_threads=n_threads, n_batch=n_batch, seed=seed, verbose=verbose)
+        if n_threads is not None and int(n_threads) < 1:
+            raise LMError(f"llamacpp: n_threads must be >= 1, got {n_threads!r}")
+        #: Fixed thread count (``n_threads`` given or ``adapt_threads=False``), else None: a governor decides.
+        self._fixed_threads = int(n_threads) if n_threads is not None else None
+        self.adapt_threads = bool(adapt_threads)
+        self._governor = (ThreadGovernor(default_threads()) if self._fixed_threads is None and self.adapt_threads
+                          else None)
+        #: Threads the last call ran on.
+        self.last_threads = 0
         self._llama: Any = None
         self._lock: threading.RLock | None = None
         self._grammars: dict[str, Any] = {}
@@ -137,6 +213,19 @@ class LlamaCppLM(LMBackend):
 
     def identity(self) -> str:
         return f"{self.name}:{self.model}"
+
+    def _set_threads(self, llama: Any) -> int:
+        """Set the shared context's threads for this call (caller holds the lock); returns the count."""
+        if self._fixed_threads is not None:
+            n = self._fixed_threads
+        elif not self.adapt_threads:
+            n = default_threads()
+        else:
+            assert self._governor is not None
+            n = self._governor.next_threads()
+        llama._ctx.set_n_threads(n, n)  # noqa: SLF001 - a plain llama_set_n_threads on the context
+        self.last_threads = n
+        return n
 
     def provenance(self) -> dict[str, Any]:
         """Identity, path and SHA-256 of the GGUF file this backend loads (hashed once per file version)."""
@@ -175,6 +264,7 @@ class LlamaCppLM(LMBackend):
         with self._lock:
             if not self.reuse_prefix:
                 llama.reset()
+            self._set_threads(llama)
             try:
                 out = llama.create_chat_completion(**kwargs)
             except ValueError as e:  # e.g. prompt longer than the context window
@@ -218,6 +308,7 @@ class LlamaCppLM(LMBackend):
                     break
                 prefix += 1
         prefix = max(0, min(prefix, len(tokens) - 1))  # always decode at least one token to get fresh logits
+        self._set_threads(llama)
         llama.n_tokens = prefix
         llama.eval(tokens[prefix:])  # eval drops KV entries past n_tokens first
         self.last_reused_tokens = prefix

@@ -53,7 +53,8 @@ class TransformersLM(LMBackend):
                         import torch
                         from transformers import AutoModelForCausalLM, AutoTokenizer
                     except ImportError as e:
-                        raise LMError("transformers backend: torch/transformers are not installed") from e
+                        raise LMError("transformers backend: torch/transformers are not installed: "
+                                      "pip install 'gift-llm[transformers]'") from e
                     try:
                         tok = AutoTokenizer.from_pretrained(self.path, local_files_only=True)
                         lm = AutoModelForCausalLM.from_pretrained(self.path, local_files_only=True,
