@@ -159,3 +159,25 @@ def test_reach_from_the_kinematics_agrees_with_drake_ik(specs, robot):
             ik.solve([*(direction * (r - REACH_MARGIN)), z], spec.rest)
             with pytest.raises(GiftError, match="no .* configuration"):
                 ik.solve([*(direction * (r + 0.03)), z], spec.rest)
+
+
+def test_gift_doctor_checks_every_registered_robot(monkeypatch):
+    import types
+
+    from gift.plugins.manager import GiftPluginManager
+    from gift_sim_drake.doctor import check_robots
+
+    @gift.hookimpl
+    def gift_register_robots(register):
+        register(ROBOTS["franka"])
+        register(attrs.evolve(ROBOTS["jaco"], name="jaco-six", rest=ROBOTS["jaco"].rest[:6]))
+
+    manager = GiftPluginManager()
+    manager.register_plugin(types.SimpleNamespace(gift_register_robots=gift_register_robots), name="arms",
+                            distribution="my-arms")
+    monkeypatch.setattr(gift, "get_manager", lambda: manager.load([]))
+    checks = {c.name: c for c in check_robots()}
+    assert checks["robot franka"].status == "ok" and "7-DoF chain" in checks["robot franka"].detail
+    bad = checks["robot jaco-six"]
+    assert bad.status == "fail" and "rest has 6 angles but the chain" in bad.detail
+    assert "my-arms" in bad.fix and "GIFT_DISABLE_PLUGINS=arms" in bad.fix

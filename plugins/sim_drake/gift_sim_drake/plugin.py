@@ -37,6 +37,7 @@ def gift_register_doctor_checks(register):
 
     register("drake", doctor.check_drake, description="pydrake imports")
     register("EGL", doctor.check_egl, description="EGL libraries for Drake's headless renders")
+    register("robots", doctor.check_robots, description="every registered robot's URDF chain and rest posture")
 
 
 @hookimpl
