@@ -6,6 +6,7 @@ Lookup of registered components::
     kernel = gift.get_kernel("language")
     lm = gift.resolve_lm()            # the embedded LM (or $GIFT_LM), cached
     gift.list_components()            # {"kernel": [...], "simulator": [...], ...}
+    gift.get_robot("franka")          # a RobotSpec; gift.robot_simulator("franka") -> "drake-franka"
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from gift.core.data import (
 )
 from gift.core.errors import GiftError, LMAnswerError, LMError, PluginError, SuiteError, UnknownComponentError
 from gift.core.pipeline import GiftPipeline
+from gift.core.robots import RobotSpec
 from gift.core.suite import Suite, load_suite
 from gift.plugins.hookspecs import hookimpl
 from gift.plugins.manager import get_manager
@@ -47,6 +49,21 @@ def get_component(kind: str, name: str, **options: Any) -> Any:
 
 def get_simulator(name: str, **options: Any):
     return get_component("simulator", name, **options)
+
+
+def get_robot(name: str) -> RobotSpec:
+    """The registered robot ``name`` (a :class:`~gift.core.robots.RobotSpec`)."""
+    return get_manager().create("robot", name)
+
+
+def robot_simulator(robot: str) -> str:
+    """The name of the simulator registered for ``robot`` (e.g. ``"drake-franka"``; the first by name when
+    several simulator plugins build one). Raises :class:`UnknownComponentError` when there is none."""
+    names = get_manager().simulators_for_robot(robot)
+    if not names:
+        raise UnknownComponentError(f"robot {robot!r} is registered but no simulator is built for it; install a "
+                                    f"simulator plugin such as gift-sim-drake")
+    return names[0]
 
 
 def get_task(name: str, **options: Any):
@@ -105,8 +122,8 @@ def list_components(kind: str | None = None) -> dict[str, list[dict[str, str]]]:
 __all__ = [
     "DISTRACTOR", "Alignment", "Appearance", "Completion", "DemonstrationPair", "FeatureBatch", "FeatureSpec",
     "FeatureTrace", "Intent", "Message", "Motivation", "ObjectSpec", "Scene", "SemanticAxis", "Trajectory",
-    "TrajectoryBatch", "Usage", "GiftError", "LMAnswerError", "LMError", "PluginError", "SuiteError",
+    "TrajectoryBatch", "Usage", "RobotSpec", "GiftError", "LMAnswerError", "LMError", "PluginError", "SuiteError",
     "UnknownComponentError", "GiftPipeline", "Suite", "load_suite", "hookimpl", "get_manager", "get_component",
-    "get_simulator", "get_task", "get_kernel", "get_intent_estimator", "get_alignment_operator",
-    "get_query_policy", "get_reward_model", "resolve_lm", "list_components",
+    "get_simulator", "get_robot", "robot_simulator", "get_task", "get_kernel", "get_intent_estimator",
+    "get_alignment_operator", "get_query_policy", "get_reward_model", "resolve_lm", "list_components",
 ]

@@ -55,6 +55,30 @@ def gift_register_simulators(register: Register) -> None:
 
 
 @hookspec
+def gift_register_robots(register: Register) -> None:
+    """Register robot arms: ``register(spec)`` with a :class:`gift.core.robots.RobotSpec` (a URDF shipped in the
+    plugin's package, base and end-effector frames, home configuration), under ``spec.name``."""
+
+
+@hookspec
+def gift_register_robot_simulators(register: Register, robot: Any) -> None:
+    """Register the simulators built for one robot (a :class:`gift.core.robots.RobotSpec`).
+
+    Called once per registered robot, after every plugin's ``gift_register_robots`` ran (and again for a
+    robot registered later), so a simulator plugin supports third-party arms without knowing them:
+    gift-sim-drake registers ``drake-<robot.name>`` here. The registrations are of kind ``simulator`` and
+    remember the robot (:meth:`gift.plugins.manager.GiftPluginManager.simulators_for_robot`).
+    """
+
+
+@hookspec
+def gift_register_motions(register: Register) -> None:
+    """Register a simulator plugin's motions for a task family, named ``<simulator plugin>/<task family>``
+    (gift-sim-drake reads ``drake/<family>``: a :class:`gift_sim_drake.families.MotionFamily` factory giving
+    the family's scene layout and candidate actions). The factory's interface is the simulator plugin's."""
+
+
+@hookspec
 def gift_register_tasks(register: Register) -> None:
     """Register :class:`gift.core.interfaces.Task` factories (task families such as ``pack_backpack``)."""
 

@@ -31,7 +31,9 @@ ENTRY_POINT_GROUP = "gift"
 
 #: kind -> hook that registers it.
 KINDS: dict[str, str] = {
+    "robot": "gift_register_robots",
     "simulator": "gift_register_simulators",
+    "motion": "gift_register_motions",
     "task": "gift_register_tasks",
     "kernel": "gift_register_kernels",
     "intent_estimator": "gift_register_intent_estimators",
@@ -46,6 +48,8 @@ KINDS: dict[str, str] = {
 }
 
 BUILTIN_PLUGINS = ("gift.tasks", "gift.suites", "gift.executors", "gift.alignment_operators", "gift.query_policies")
+#: Called once per registered robot (``robot=spec``); what it registers is of kind ``simulator``.
+ROBOT_SIMULATOR_HOOK = "gift_register_robot_simulators"
 
 
 class PluginWarning(UserWarning):
@@ -66,7 +70,12 @@ class Component:
 
     def create(self, **options: Any) -> Any:
         """``factory(**options)``; options the factory does not take are a :class:`ComponentOptionError`
-        listing the valid ones (checked against its signature before it is called)."""
+        listing the valid ones (checked against its signature before it is called). A robot is registered
+        as data (a :class:`~gift.core.robots.RobotSpec`) and returned as it is."""
+        if self.kind == "robot":
+            if options:
+                raise PluginError(f"robot {self.name!r} is a RobotSpec and takes no options, got {sorted(options)}")
+            return self.factory
         self.check_options(options)
         return self.factory(**options)
 
@@ -132,7 +141,12 @@ class GiftPluginManager:
         self.pm.register(plugin, name=name)
         self._distribution[name] = distribution
         if self._loaded:
+            before = set(self._registry["robot"])
             self._collect_from(name)
+            new = [r for n, r in self._registry["robot"].items() if n not in before]
+            old = [r for n, r in self._registry["robot"].items() if n in before]
+            self._collect_robot_simulators(new, None)  # every plugin's simulators for the new robots
+            self._collect_robot_simulators(old, name)  # the new plugin's simulators for the known robots
 
     def load(self, entry_points: Iterable[importlib.metadata.EntryPoint] | None = None) -> "GiftPluginManager":
         if self._loaded:
@@ -161,6 +175,7 @@ class GiftPluginManager:
         self._loaded = True
         for name, _ in self.pm.list_name_plugin():
             self._collect_from(name)
+        self._collect_robot_simulators(self._registry["robot"].values(), None)
         return self
 
     def _collect_from(self, plugin_name: str) -> None:
@@ -180,7 +195,25 @@ class GiftPluginManager:
                     warnings.warn(f"gift plugin {plugin_name!r}: hook {hook_name} raised {type(e).__name__}: {e}; "
                                   f"its remaining registrations were skipped", PluginWarning, stacklevel=2)
 
-    def _registrar(self, kind: str, plugin_name: str) -> Callable[..., None]:
+    def _collect_robot_simulators(self, robots: Iterable[Any], only_plugin: str | None) -> None:
+        """Call :data:`ROBOT_SIMULATOR_HOOK` for each robot (of every plugin, or of ``only_plugin``)."""
+        robots = sorted((c.factory for c in robots), key=lambda r: r.name)
+        for impl in getattr(self.pm.hook, ROBOT_SIMULATOR_HOOK).get_hookimpls():
+            plugin_name = self.pm.get_name(impl.plugin)
+            if only_plugin is not None and plugin_name != only_plugin:
+                continue
+            for robot in robots:
+                try:
+                    impl.function(register=self._registrar("simulator", plugin_name, robot=robot.name), robot=robot)
+                except PluginError:
+                    raise
+                except Exception as e:  # noqa: BLE001
+                    self.failed[plugin_name] = f"{ROBOT_SIMULATOR_HOOK}({robot.name}): {type(e).__name__}: {e}"
+                    warnings.warn(f"gift plugin {plugin_name!r}: hook {ROBOT_SIMULATOR_HOOK} raised "
+                                  f"{type(e).__name__}: {e} for robot {robot.name!r}; no simulator of it registered",
+                                  PluginWarning, stacklevel=2)
+
+    def _registrar(self, kind: str, plugin_name: str, robot: str | None = None) -> Callable[..., None]:
         dist = self._distribution.get(plugin_name, "?")
 
         def register(name: Any, factory: Any = None, *, description: str = "", help: str = "", **extra: Any) -> None:
@@ -199,12 +232,16 @@ class GiftPluginManager:
                 raise PluginError(f"plugin {plugin_name!r} registered the {kind} class {factory.__name__} as {name!r}, "
                                   f"but its name attribute is {own!r}: a component's name has one source; "
                                   f"use register({factory.__name__}) or make them agree")
+            if kind == "robot":
+                description = description or _check_robot(plugin_name, name, factory)
+            if robot is not None:
+                extra = {**extra, "robot": robot}
             existing = self._registry[kind].get(name)
             if existing is not None:
                 raise PluginError(f"two plugins register the {kind} {name!r}: {existing.plugin!r} (distribution "
                                   f"{existing.distribution!r}) and {plugin_name!r} (distribution {dist!r}); "
                                   f"uninstall one or disable it with GIFT_DISABLE_PLUGINS")
-            if not description and kind not in ("suite",):
+            if not description and kind not in ("suite", "robot"):
                 doc = getattr(factory, "__doc__", None) or ""
                 description = doc.strip().splitlines()[0] if doc.strip() else ""
             self._registry[kind][name] = Component(kind, name, factory, plugin_name, dist, description, extra)
@@ -238,6 +275,11 @@ class GiftPluginManager:
                               f"{type(obj).__name__} named {own!r}: a component's name has one source")
         return obj
 
+    def simulators_for_robot(self, robot: str) -> list[str]:
+        """Names of the simulators registered for ``robot`` (through ``gift_register_robot_simulators``)."""
+        self.get("robot", robot)  # unknown robots: the usual error listing the registered ones
+        return sorted(c.name for c in self._registry["simulator"].values() if c.extra.get("robot") == robot)
+
     def suites(self) -> dict[str, str]:
         return {c.name: str(c.factory) for c in self._registry["suite"].values()}
 
@@ -246,6 +288,19 @@ class GiftPluginManager:
         if kind not in KINDS:
             raise PluginError(f"unknown component kind {kind!r}; kinds: {sorted(KINDS)}")
         return kind
+
+
+def _check_robot(plugin_name: str, name: str, spec: Any) -> str:
+    """A registered robot must be a RobotSpec named like its registration; returns its description."""
+    from gift.core.robots import RobotSpec
+
+    if not isinstance(spec, RobotSpec):
+        raise PluginError(f"plugin {plugin_name!r} registered robot {name!r} as a {type(spec).__name__}; register a "
+                          f"gift.core.robots.RobotSpec")
+    if spec.name != name:
+        raise PluginError(f"plugin {plugin_name!r} registered robot {name!r} with a RobotSpec named {spec.name!r}; "
+                          f"the two names must agree")
+    return spec.description
 
 
 _manager: GiftPluginManager | None = None

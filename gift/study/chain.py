@@ -139,11 +139,15 @@ class StudyConfig:
 
 
 def simulator_name(robot: str) -> str:
-    """The registered simulator of ``robot``: the name itself when it is a simulator, else ``drake-<robot>``."""
+    """The registered simulator of ``robot``: the name itself when it is a simulator, else the one built for
+    the registered robot ``robot`` (:func:`gift.robot_simulator`; gift-sim-drake: ``drake-<robot>``)."""
     from gift.plugins.manager import get_manager
 
-    names = get_manager().names("simulator")
-    return robot if robot in names else f"drake-{robot}"
+    manager = get_manager()
+    if robot in manager.names("simulator"):
+        return robot
+    built = manager.simulators_for_robot(robot) if robot in manager.names("robot") else []
+    return built[0] if built else f"drake-{robot}"  # unknown: the simulator lookup's error lists what exists
 
 
 def intent_seeds(cfg: StudyConfig, intent_id: str) -> dict[str, tuple[int, ...]]:

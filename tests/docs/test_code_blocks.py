@@ -16,7 +16,7 @@ DRAKE_PAGES = {"tutorials/task-plugin.md", "tutorials/pipeline.md"}
 LM_PAGES = {"lm.md", "caching.md"}
 #: The blocks that are not run: hosted/remote LMs, and code that needs the example packages installed
 #: (tests/docs/test_example_packages.py runs that code in a fresh venv instead).
-MAX_SKIPPED = 6
+MAX_SKIPPED = 7
 
 
 def _param(path: Path):

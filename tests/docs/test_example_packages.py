@@ -18,7 +18,7 @@ import pytest
 from doc_blocks import ROOT
 
 EXAMPLES = ROOT / "examples"
-PACKAGES = ("gift-example-kernel", "gift-example-task")
+PACKAGES = ("gift-example-kernel", "gift-example-task", "gift-example-robot")
 
 pytestmark = pytest.mark.slow
 
@@ -61,12 +61,14 @@ def fresh_env(tmp_path_factory) -> FreshEnv:
 
 
 def test_examples_are_installed_only_in_the_fresh_env_and_discovered_by_entry_point(fresh_env):
-    for module in ("gift_example_kernel", "gift_example_task"):
+    for module in ("gift_example_kernel", "gift_example_task", "gift_example_robot"):
         assert subprocess.run([sys.executable, "-c", f"import {module}"], capture_output=True).returncode != 0
     listed = json.loads(fresh_env.run_py("-m", "gift.cli", "plugins", "--json").stdout)
     rows = {(c["kind"], c["name"]): c["distribution"] for c in listed["components"]}
     assert rows[("kernel", "keyword-overlap")] == "gift-example-kernel"
     assert rows[("task", "pack_backpack_low")] == "gift-example-task"
+    assert rows[("robot", "ur5e")] == "gift-example-robot"
+    assert rows[("simulator", "drake-ur5e")] == "gift-sim-drake"  # built by the Drake plugin for the new robot
     assert not listed["failed_plugins"]
 
 
@@ -83,7 +85,36 @@ def test_kernel_package_benchmarks_run(fresh_env):
 @pytest.mark.drake
 def test_task_package_tests_pass_on_drake(fresh_env):
     out = fresh_env.pytest("gift-example-task", "tests", "-rs")
-    assert "4 passed" in out and "skipped" not in out, out
+    assert "5 passed" in out and "skipped" not in out, out
+
+
+@pytest.mark.drake
+def test_robot_package_tests_pass_on_drake(fresh_env):
+    out = fresh_env.pytest("gift-example-robot", "tests", "-rs")
+    assert "3 passed" in out and "skipped" not in out, out
+
+
+@pytest.mark.drake
+@pytest.mark.lm
+def test_demo_runs_end_to_end_on_the_third_party_robot(fresh_env, tmp_path):
+    """``gift demo --robot ur5e``: Drake demonstrations on the UR5e, intent inferred by the embedded LM,
+    alignment and win rates, at the demo's own (small) sizes."""
+    help_text = fresh_env.run_py("-m", "gift.cli", "demo", "--help").stdout
+    assert "ur5e" in help_text.split("--robot", 1)[1].split("\n", 1)[0]  # the choices come from the registry
+    out_dir = tmp_path / "demo-ur5e"
+    proc = fresh_env.run_py("-m", "gift.cli", "-q", "demo", "--robot", "ur5e", "--out", str(out_dir),
+                            timeout=3600)  # 667 CPU-s from an empty cache; slower on a busy machine
+    lines = proc.stdout.strip().splitlines()
+    assert lines[0].startswith("intent 'art_supplies': inferred -> ")
+    header = next(i for i, ln in enumerate(lines) if ln.split()[:1] == ["kernel"])
+    rows = {ln.split()[0]: ln.split()[1:] for ln in lines[header + 1:-1]}
+    assert set(rows) == {"vision", "language", "gift-prob", "oracle-labels"}, proc.stdout
+    for name, values in rows.items():
+        assert 0.0 <= float(values[0]) <= 1.0, (name, values)
+    results = json.loads((out_dir / "results.json").read_text())
+    assert results["config"]["robot"] == "ur5e"
+    assert float(rows["oracle-labels"][0]) > 0.5  # the reward learned on UR5e demonstrations beats chance
+    print(proc.stdout)
 
 
 def test_example_kernel_aligns_from_the_command_line(fresh_env):

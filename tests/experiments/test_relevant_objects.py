@@ -60,7 +60,7 @@ def test_the_objects_the_human_steers_the_mug_around_are_inferred(setting, inten
     towards the others (the layout puts the two kinds on opposite sides of the straight carry). The objects
     every preferred carry keeps further from than every default carry are the relevant ones."""
     from gift.tasks import EE_HEIGHT_SCALE
-    from gift_sim_drake.motion import MUG_RAISED
+    from gift_sim_drake.tabletop import MUG_RAISED
 
     pairs, spec = demonstrations(setting, intent_id)
     res = infer_relevant_objects(pairs, spec.train_objects)

@@ -12,4 +12,5 @@ OBJECTS = (
 )
 RELEVANT = ("paintbrush", "sketchbook")
 FAMILIES = ("pack_backpack", "store_drawer", "sweep_spill", "place_mug")
-ROBOTS = ("drake-franka", "drake-jaco")
+#: The built-in arms and the example package's 6-DoF UR5e (registered by the conftest).
+ROBOTS = ("drake-franka", "drake-jaco", "drake-ur5e")

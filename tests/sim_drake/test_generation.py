@@ -1,4 +1,4 @@
-"""Trajectory generation on the real plant: both arms, all four families."""
+"""Trajectory generation on the real plant: the built-in arms and the example UR5e, all four families."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from gift.core.data import ObjectSpec
 from gift.core.errors import GiftError
 from gift_sim_drake.motion import N_STEPS
 from gift_sim_drake.plant import SceneModel
+from gift_sim_drake.simulator import DrakeSimulator
 
 from sim_drake_catalog import FAMILIES, RELEVANT, ROBOTS
 
@@ -34,7 +35,7 @@ def test_shapes_and_joint_limits_on_the_plant(generated, simulators, objects, ro
     model = SceneModel(simulators[robot].robot, family, objects, scene.landmarks)
     lo, hi = model.joint_limits()
     for gen, b in batches.items():
-        assert b.joint_positions.shape == (12, N_STEPS, 7)
+        assert b.joint_positions.shape == (12, N_STEPS, simulators[robot].dof)
         assert b.object_positions.shape == (12, N_STEPS, 4, 3)
         assert (b.joint_positions >= lo).all() and (b.joint_positions <= hi).all(), gen
         assert b.ee_positions[..., 2].min() > 0.0  # never through the table
@@ -112,7 +113,7 @@ def test_same_seed_same_data_bit_for_bit(simulators, objects, robot):
         a_scene = simulators[robot].make_scene(family, objects, RELEVANT, seed=11)
         a = simulators[robot].generate(a_scene, "random", 20, seed=5)
         plant._IK.clear()  # a fresh simulator and IK cache must give the same bits
-        fresh = type(simulators[robot])()
+        fresh = DrakeSimulator(simulators[robot].robot.name)
         b_scene = fresh.make_scene(family, objects, RELEVANT, seed=11)
         b = fresh.generate(b_scene, "random", 20, seed=5)
         assert np.array_equal(a_scene.positions, b_scene.positions) and a_scene.landmarks == b_scene.landmarks

@@ -57,3 +57,24 @@ def test_drake_demonstrations_pack_relevant_objects_and_carry_low(drake, tiny_ob
     builtin = drake.generate(demos.scene, "preferred", 6, seed=3)
     builtin_height = drake.features(builtin, family).values[..., height].max(axis=1).mean()
     assert best_height <= builtin_height
+
+
+
+@pytest.mark.drake
+def test_its_own_drake_motions_let_the_preferred_generator_carry_low(drake, tiny_objects):
+    train, _, _ = tiny_objects
+    relevant = ["paintbrush", "sketchbook"]
+    family = gift.get_task("pack_backpack_low")
+    scene = drake.make_scene("pack_backpack_low", train, relevant, seed=3)  # staged by drake/pack_backpack_low
+    usual_scene = drake.make_scene("pack_backpack", train, relevant, seed=3)  # same layout, the usual motions
+    assert np.array_equal(usual_scene.positions, scene.positions)
+    low = drake.generate(scene, "preferred", 6, seed=0)
+    usual = drake.generate(usual_scene, "preferred", 6, seed=0)
+    assert set(low.meta["acted_on"]) <= set(relevant)
+    assert all(label.endswith("carried low") for label in low.meta["action_labels"])
+    f_low, f_usual = drake.features(low, family), drake.features(usual, family)
+    height = f_low.names.index("ee_height")
+    grasped = 20  # the grasp keyframe's step: from here on the object is carried
+    assert f_low.values[:, grasped:, height].max() < f_usual.values[:, grasped:, height].max(axis=1).min()
+    # (the start posture, 0.3 m high, is the same for both: it bounds the whole trajectory's highest point)
+    assert family.ground_truth_reward(f_low, relevant).mean() > family.ground_truth_reward(f_usual, relevant).mean()

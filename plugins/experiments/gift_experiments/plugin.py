@@ -28,6 +28,19 @@ def _split(s: str) -> tuple[str, ...]:
     return tuple(x.strip() for x in s.split(",") if x.strip())
 
 
+def robot_choices() -> list[str]:
+    """Registered robots that some simulator plugin builds a simulator for (the choices of ``--robot``)."""
+    from gift.plugins.manager import get_manager
+
+    manager = get_manager()
+    return [r for r in manager.names("robot") if manager.simulators_for_robot(r)]
+
+
+def _add_robot_argument(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--robot", default="jaco", choices=robot_choices(),
+                   help=f"{what}: a registered robot (gift plugins lists them; default: %(default)s)")
+
+
 def check_kernels(specs: tuple[str, ...]) -> tuple[str, ...]:
     """The kernel specs, or a GiftError naming the unknown ones and the registered kernels."""
     from gift.study.components import parse_spec
@@ -68,14 +81,15 @@ def _configure_reproduce(p: argparse.ArgumentParser) -> None:
     from gift.study.chain import ALL_KERNELS
 
     p.add_argument("--suite", default="gift-paper", help="registered suite name or suite file")
-    p.add_argument("--robot", default="jaco", help="robot of the training and test scenes (a registered simulator "
-                                                   "or drake-<robot>)")
+    _add_robot_argument(p, "robot of the training and test scenes")
     p.add_argument("--pairs", type=int, default=250, help="trajectory pairs per test scene")
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--samples", type=int, default=10, help="LM samples per alignment (gift, lm-no-intent)")
     p.add_argument("--lm", default=None, help="LM to use (default: the embedded model)")
-    p.add_argument("--kernels", default=",".join(ALL_KERNELS), help="comma-separated kernel specs")
-    p.add_argument("--reward", default="maxent-linear", help="registered reward model")
+    p.add_argument("--kernels", default=",".join(ALL_KERNELS),
+                   help=f"comma-separated kernel specs (registered kernels: {', '.join(_names('kernel'))})")
+    p.add_argument("--reward", default="maxent-linear", choices=_names("reward_model"),
+                   help="a registered reward model (default: %(default)s)")
     p.add_argument("--intents", default="", help="comma-separated intent ids (default: all)")
     p.add_argument("--intent-source", default="inferred", choices=["inferred", "ground-truth"])
     p.add_argument("--thresholds", default="train-calibrated,non-oracle,oracle")
@@ -151,7 +165,7 @@ def run_reproduce(args: argparse.Namespace) -> int:
 
 def _configure_demo(p: argparse.ArgumentParser) -> None:
     p.add_argument("--intent", default="art_supplies", help="intent id of the gift-paper suite")
-    p.add_argument("--robot", default="jaco", help="robot (a registered simulator or drake-<robot>)")
+    _add_robot_argument(p, "robot of the scenes")
     p.add_argument("--lm", default=None, help="LM to use (default: the embedded model)")
     p.add_argument("--kernels", default="vision,language,gift-prob",
                    help="comma-separated kernels (add gift,lm-no-intent for the binary Call-3 kernels: slow on CPU)")
@@ -222,7 +236,7 @@ def _configure_evaluate_alignment(p: argparse.ArgumentParser) -> None:
     p.add_argument("--intent-source", default="ground-truth", choices=("ground-truth", "inferred"),
                    help="ground-truth intent text and relevant training objects, or both inferred by the GIFT "
                         "front half from simulated demonstrations")
-    p.add_argument("--robot", default="jaco", help="robot of the demonstrations (inferred intents)")
+    _add_robot_argument(p, "robot of the demonstrations (inferred intents)")
     p.add_argument("--threshold", default=",".join(THRESHOLDS),
                    help=f"comma-separated threshold strategies (default: all of {','.join(THRESHOLDS)})")
     p.add_argument("--intents", default=None, help="comma-separated intent ids (default: all)")

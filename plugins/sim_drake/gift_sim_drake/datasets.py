@@ -85,11 +85,12 @@ def load_dataset(path: str | os.PathLike) -> tuple[TrajectoryBatch, FeatureBatch
 
 
 def dataset_key(robot: str, task: str, objects: Sequence[ObjectSpec], relevant: Sequence[str], scene_seed: int,
-                generator: str, n: int, seed: int) -> str:
-    """A stable hash of everything that determines a generated dataset."""
+                generator: str, n: int, seed: int, robot_fingerprint: str = "") -> str:
+    """A stable hash of everything that determines a generated dataset (``robot_fingerprint``:
+    :func:`gift_sim_drake.robots.robot_fingerprint`, so an edited URDF or spec makes a new key)."""
     from importlib.metadata import version
 
-    config = {"robot": robot, "task": task, "relevant": sorted(relevant), "scene_seed": int(scene_seed),
+    config = {"robot": robot, "robot_fingerprint": robot_fingerprint, "task": task, "relevant": sorted(relevant), "scene_seed": int(scene_seed),
               "generator": generator, "n": int(n), "seed": int(seed), "format": FORMAT_VERSION,
               "package": version("gift-sim-drake"),
               "objects": [[o.name, o.appearance.shape, list(o.appearance.size), list(o.appearance.color)]
@@ -107,7 +108,10 @@ def generate_or_load(simulator, task: str, objects: Sequence[ObjectSpec], releva
     objects = as_object_specs(objects)
     if cache_dir is None:
         cache_dir = cache_root() / "datasets"
-    key = dataset_key(simulator.robot.name, task, objects, relevant, scene_seed, generator, n, seed)
+    from gift_sim_drake.robots import robot_fingerprint
+
+    key = dataset_key(simulator.robot.name, task, objects, relevant, scene_seed, generator, n, seed,
+                      robot_fingerprint(simulator.robot))
     stem = Path(cache_dir) / f"{simulator.name}-{task}-{generator}-{key}"
     if stem.with_suffix(".npz").exists() and stem.with_suffix(".json").exists():
         batch, features, _ = load_dataset(stem)

@@ -3,7 +3,8 @@
 :class:`ArmKinematics` walks the chain ``base link -> ee link`` of a URDF: fixed transforms (``origin``)
 and revolute joints (``axis``). Forward kinematics runs over any batch shape ``[..., dof]`` at once, which
 is what makes trajectory generation fast; a test checks it against Drake's ``MultibodyPlant`` to 1e-6 m.
-Units: metres and radians, positions in the robot base frame (= world frame, the base sits at the origin).
+Units: metres and radians, positions in the world frame (the base link placed at the robot's mount pose;
+at the origin by default).
 """
 
 from __future__ import annotations
@@ -42,9 +43,10 @@ def _floats(text: str | None, default: str) -> np.ndarray:
 class ArmKinematics:
     """The kinematic chain of one arm: ``dof`` revolute joints between fixed transforms.
 
-    ``origins[i]``: 4x4 transform from the previous joint's frame to joint ``i``'s frame (fixed joints
-    folded in); ``axes[i]``: unit rotation axis of joint ``i`` in its own frame; ``tool``: joint ``dof-1``'s
-    frame to the end-effector frame. ``lower``/``upper``: joint limits ``[dof]`` in radians.
+    ``origins[i]``: 4x4 transform from the previous joint's frame (the world, for ``i = 0``) to joint ``i``'s
+    frame (the mount pose and fixed joints folded in); ``axes[i]``: unit rotation axis of joint ``i`` in its
+    own frame; ``tool``: joint ``dof-1``'s frame to the end-effector frame. ``lower``/``upper``: joint limits
+    ``[dof]`` in radians (infinite for URDF ``continuous`` joints).
     """
 
     joint_names: tuple[str, ...]
@@ -61,9 +63,18 @@ class ArmKinematics:
         return len(self.joint_names)
 
     @classmethod
-    def from_urdf(cls, path: str | Path, base_link: str, ee_link: str) -> "ArmKinematics":
-        """Read the chain from ``base_link`` to ``ee_link`` of the URDF at ``path``."""
-        root = ET.parse(path).getroot()
+    def from_urdf(cls, path: str | Path, base_link: str, ee_link: str,
+                  mount: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)) -> "ArmKinematics":
+        """Read the chain from ``base_link`` to ``ee_link`` of the URDF at ``path``; ``mount`` is the base link's
+        pose in the world ``(x, y, z, roll, pitch, yaw)``."""
+        try:
+            root = ET.parse(path).getroot()
+        except (ET.ParseError, OSError) as e:
+            raise GiftError(f"{path}: cannot read the URDF: {e}") from None
+        links = {link.get("name") for link in root.findall("link")}
+        for what, name in (("base link", base_link), ("end-effector link", ee_link)):
+            if name not in links:
+                raise GiftError(f"{path}: no {what} {name!r}; links: {sorted(links)}")
         by_child = {j.find("child").get("link"): j for j in root.findall("joint")}
         chain = []
         link = ee_link
@@ -75,7 +86,7 @@ class ArmKinematics:
             link = joint.find("parent").get("link")
         chain.reverse()
         names, origins, axes, lower, upper = [], [], [], [], []
-        pending = np.eye(4)
+        pending = _homogeneous(mount[:3], mount[3:]) if any(mount) else np.eye(4)
         for joint in chain:
             origin = joint.find("origin")
             t = _homogeneous(_floats(origin.get("xyz") if origin is not None else None, "0 0 0"),
@@ -84,17 +95,21 @@ class ArmKinematics:
             kind = joint.get("type")
             if kind == "fixed":
                 continue
-            if kind != "revolute":
-                raise GiftError(f"{path}: joint {joint.get('name')!r} has type {kind!r}; only revolute and fixed "
-                                f"joints are supported")
+            if kind not in ("revolute", "continuous"):
+                raise GiftError(f"{path}: joint {joint.get('name')!r} has type {kind!r}; only revolute, continuous "
+                                f"and fixed joints are supported between the base and the end effector")
             axis = _floats(joint.find("axis").get("xyz") if joint.find("axis") is not None else None, "1 0 0")
             limit = joint.find("limit")
+            if kind == "revolute" and (limit is None or limit.get("lower") is None or limit.get("upper") is None):
+                raise GiftError(f"{path}: revolute joint {joint.get('name')!r} needs <limit lower=.. upper=..>")
             names.append(joint.get("name"))
             origins.append(pending)
             axes.append(axis / np.linalg.norm(axis))
-            lower.append(float(limit.get("lower")))
-            upper.append(float(limit.get("upper")))
+            lower.append(float(limit.get("lower")) if kind == "revolute" else -np.inf)
+            upper.append(float(limit.get("upper")) if kind == "revolute" else np.inf)
             pending = np.eye(4)
+        if not names:
+            raise GiftError(f"{path}: the chain from {base_link!r} to {ee_link!r} has no movable joint")
         return cls(tuple(names), np.array(origins), np.array(axes), pending, np.array(lower), np.array(upper),
                    base_link, ee_link)
 

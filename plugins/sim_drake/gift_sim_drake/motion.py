@@ -1,15 +1,10 @@
-"""Trajectory generation: keyframes solved by Drake IK, joint-space interpolation, batched forward kinematics.
+"""Trajectory generation for any arm: keyframes solved by Drake IK, joint-space interpolation, batched
+forward kinematics.
 
-For a scene, every family has a finite set of candidate *actions*, each acting on one thing:
-
-- pack_backpack / store_drawer: pick object ``i`` and put it into the open container
-  (keyframes: pre-grasp, grasp, lift, transit, above the container, place);
-- sweep_spill: push object ``i`` sideways (towards +y or -y) across the table
-  (pre-contact, contact, mid-push, end of push, retreat);
-- place_mug: carry the mug from its start to its goal (start, lift, three via points, above the goal,
-  place): low (:data:`CARRY_HEIGHT`), passing each via point on the straight line or
-  :data:`MUG_STEER` to either side of it (27 routes: straight, shifted to one side, bends and S-curves
-  around single objects), or raised over the table (:data:`MUG_RAISED`).
+For a scene, the task family's :class:`~gift_sim_drake.families.MotionFamily` gives a finite set of candidate
+*actions* (an :class:`~gift_sim_drake.families.ActionSet`), each acting on one thing: tool-centre-point
+keyframes with the gripper pointing down, and the object (or the family's landmark, e.g. the mug) it moves.
+The paper's four families are in :mod:`gift_sim_drake.tabletop`.
 
 Drake's ``InverseKinematics`` solves each action's nominal keyframes once per scene (cached). Each
 generated trajectory then perturbs its keyframes (start posture, grasp and place points, lift height,
@@ -28,7 +23,6 @@ random so demonstrations cover every relevant object); ``random`` takes a unifor
 
 from __future__ import annotations
 
-import itertools
 import threading
 from collections import OrderedDict
 
@@ -37,129 +31,20 @@ import numpy as np
 
 from gift.core.data import Scene, TrajectoryBatch
 from gift.core.errors import GiftError
+from gift_sim_drake.families import N_STEPS, ActionSet, check_scene, motion_family
 from gift_sim_drake.features import compute_features, resolve_task
-from gift_sim_drake.plant import CONTAINERS, drake_ik, footprint_radius, half_height
-from gift_sim_drake.robots import RobotSpec
-from gift_sim_drake.scenes import FAMILIES, check_family, lift_height, nominal_target
+from gift_sim_drake.plant import drake_ik
+from gift_sim_drake.robots import RobotSpec, arm_kinematics
 
-N_STEPS = 61
 GENERATORS = ("preferred", "default", "random")
 TIE_TOLERANCE = 0.05
 #: Damped-least-squares residual (m + axis error) above which a keyframe is re-solved by Drake.
 REFINE_TOLERANCE = 1e-3
 
-PUSH_LENGTH = 0.24
-CARRY_HEIGHT = 0.18
-#: place_mug via points, as fractions of the way from the mug's start to its goal.
-MUG_VIAS = (0.25, 0.5, 0.75)
-#: place_mug low carries: at each via point the mug passes on the straight line or this far (m) to either side.
-MUG_STEER = 0.15
-#: place_mug raised carries: (lateral offset of the middle via point in m, towards +x; height of the via points in m).
-MUG_RAISED = ((0.0, 0.38), (-0.1, 0.3), (0.15, 0.3))
-
-
-def mug_routes() -> tuple[tuple[tuple[float, ...], float], ...]:
-    """place_mug routes: ``((lateral offset at each of MUG_VIAS in m, towards +x), height in m)``; the first is
-    the straight low carry (the nominal one), then the other low carries, then the raised ones."""
-    sides = (0.0, -MUG_STEER, MUG_STEER)
-    low = [(offsets, CARRY_HEIGHT) for offsets in itertools.product(sides, repeat=len(MUG_VIAS))]
-    raised = [(tuple(offset * np.sin(np.pi * f) for f in MUG_VIAS), height) for offset, height in MUG_RAISED]
-    return tuple(low + raised)
-
-
-def _route_label(offsets: tuple[float, ...], height: float) -> str:
-    if height == CARRY_HEIGHT and not any(offsets):
-        return "carry the mug straight to the goal"
-    where = "low" if height == CARRY_HEIGHT else f"raised to {height:.2f} m"
-    return f"carry the mug {where}, passing the via points at {'/'.join(f'{o:+.2f}' for o in offsets)} m sideways"
-
-
-@attrs.frozen
-class ActionSet:
-    """The candidate actions of one scene.
-
-    ``targets`` ``[A, K, 3]``: nominal end-effector keyframes (m); ``times`` ``[K]``: their step indices
-    (a keyframe at 0 means the trajectory starts there, otherwise it starts at the rest posture);
-    ``carried`` ``[A]``: object index acted on (-1: the mug); ``attach``/``detach``: keyframe indices of
-    grasp/contact and release (None: held to the end); ``push``: the object follows in the table plane only;
-    ``labels``: what each action does; ``nominal``: the default controller's action.
-    """
-
-    targets: np.ndarray = attrs.field(eq=False)
-    times: tuple[int, ...]
-    carried: np.ndarray = attrs.field(eq=False)
-    attach: int
-    detach: int | None
-    push: bool
-    labels: tuple[str, ...]
-    nominal: int
-
-    @property
-    def start_from_rest(self) -> bool:
-        return self.times[0] != 0
-
-
-def check_scene(scene: Scene) -> str:
-    """The family's landmark, after checking ``scene`` has what motion needs (else a clear error)."""
-    mark = check_family(scene.task)
-    need = {"mug": ("mug", "mug_goal")}.get(mark, (mark,))
-    missing = [k for k in need if k not in scene.landmarks]
-    if missing or np.asarray(scene.positions).shape != (len(scene.objects), 3) or not scene.objects:
-        raise GiftError(f"this {scene.task} scene (seed {scene.seed}) lacks object positions or the landmarks "
-                        f"{list(need)} (missing {missing}); build scenes with the simulator's make_scene")
-    return mark
-
 
 def build_actions(scene: Scene) -> ActionSet:
-    """The candidate actions of ``scene`` (see the module docstring)."""
-    mark = check_scene(scene)
-    pos = np.asarray(scene.positions)
-    names = scene.object_names
-    if mark in CONTAINERS:
-        c = np.asarray(scene.landmarks[mark], dtype=float)
-        above = np.array([c[0], c[1], CONTAINERS[mark]["height"] + 0.08])
-        targets = []
-        for p in pos:
-            lift = np.array([p[0], p[1], lift_height(p[2])])
-            transit = np.array([(p[0] + c[0]) / 2, (p[1] + c[1]) / 2, max(lift[2], above[2]) + 0.03])
-            grasp = np.array([p[0], p[1], max(p[2], 0.02)])  # thin objects: keep the fingers off the table
-            targets.append([grasp + [0, 0, 0.12], grasp, lift, transit, above, c])
-        return ActionSet(np.array(targets), (12, 20, 30, 40, 50, 60), np.arange(len(pos)), 1, None, False,
-                         tuple(f"put {n} into the {mark}" for n in names),
-                         nominal_target(scene.task, pos, dict(scene.landmarks)))
-    if mark == "spill":
-        s = np.asarray(scene.landmarks["spill"], dtype=float)
-        targets, carried, labels = [], [], []
-        for i, (p, o) in enumerate(zip(pos, scene.objects)):
-            for side in (1.0, -1.0):
-                d = np.array([0.0, side, 0.0])
-                contact = p - d * (footprint_radius(o.appearance) + 0.02)
-                contact[2] = min(max(half_height(o.appearance), 0.03), 0.06)
-                end = contact + d * PUSH_LENGTH
-                targets.append([contact + [0, 0, 0.12], contact, contact + d * PUSH_LENGTH / 2, end,
-                                end + [0, 0, 0.12]])
-                carried.append(i)
-                labels.append(f"push {o.name} towards {'+y' if side > 0 else '-y'}")
-        k = nominal_target(scene.task, pos, dict(scene.landmarks))
-        away = 0 if pos[k, 1] >= s[1] else 1
-        return ActionSet(np.array(targets), (14, 22, 34, 46, 60), np.array(carried), 1, 3, True, tuple(labels),
-                         2 * k + away)
-    start = np.asarray(scene.landmarks["mug"], dtype=float)
-    goal = np.asarray(scene.landmarks["mug_goal"], dtype=float)
-    line = goal - start
-    normal = np.array([-line[1], line[0], 0.0]) / np.linalg.norm(line[:2])
-    normal *= np.sign(normal[0]) or 1.0  # positive offsets point away from the robot (+x)
-    lift = np.array([start[0], start[1], CARRY_HEIGHT])
-    above = np.array([goal[0], goal[1], CARRY_HEIGHT])
-    routes = mug_routes()
-    targets, labels = [], []
-    for offsets, height in routes:
-        vias = [start + f * line + offset * normal for f, offset in zip(MUG_VIAS, offsets)]
-        vias = [np.array([v[0], v[1], height]) for v in vias]
-        targets.append([start, lift, *vias, above, goal])
-        labels.append(_route_label(offsets, height))
-    return ActionSet(np.array(targets), (0, 8, 20, 30, 40, 52, 60), np.full(len(routes), -1), 0, None, False,
-                     tuple(labels), 0)
+    """The candidate actions of ``scene`` (its motion family's, after checking the scene)."""
+    return check_scene(scene).actions(scene)
 
 
 def _blend(times: tuple[int, ...], start_from_rest: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -182,7 +67,7 @@ class MotionPlanner:
 
     def __init__(self, robot: RobotSpec, cache_size: int = 64) -> None:
         self.robot = robot
-        self.kin = robot.kinematics
+        self.kin = arm_kinematics(robot)
         self.rest = np.asarray(robot.rest, dtype=float)
         self._cache: OrderedDict[tuple, tuple[ActionSet, np.ndarray, np.ndarray]] = OrderedDict()
         self._cache_size = cache_size
@@ -195,7 +80,7 @@ class MotionPlanner:
                 tuple(o.appearance for o in scene.objects))
 
     def prepare(self, scene: Scene) -> tuple[ActionSet, np.ndarray, np.ndarray]:
-        """``(actions, anchors [A, K, 7], feasible [A])``: Drake IK at each action's nominal keyframes."""
+        """``(actions, anchors [A, K, dof], feasible [A])``: Drake IK at each action's nominal keyframes."""
         key = self._scene_key(scene)
         with self._lock:
             if key in self._cache:
@@ -246,35 +131,15 @@ class MotionPlanner:
         best = np.flatnonzero(rewards >= rewards.max() - TIE_TOLERANCE)
         return rng.choice(best, size=n)
 
-    def perturb(self, acts: ActionSet, chosen: np.ndarray, rng: np.random.Generator,
+    def perturb(self, scene: Scene, acts: ActionSet, chosen: np.ndarray, rng: np.random.Generator,
                 scale: float) -> tuple[np.ndarray, np.ndarray]:
-        """Per-trajectory keyframe targets ``[n, K, 3]`` and start postures ``[n, 7]``."""
+        """Per-trajectory keyframe targets ``[n, K, 3]`` (the motion family's
+        :meth:`~gift_sim_drake.families.MotionFamily.perturb`) and start postures ``[n, dof]`` (the rest
+        posture plus Gaussian noise of 0.06 rad per joint, clipped to the limits)."""
         n = len(chosen)
-        targets = acts.targets[chosen].copy()
         start = np.clip(self.rest + rng.normal(0.0, 0.06 * scale, size=(n, self.kin.dof)),
                         self.kin.lower, self.kin.upper)
-        if acts.push:  # contact point and push length
-            grip = rng.uniform(-0.01, 0.01, size=(n, 1, 3)) * scale * [1, 0, 0]
-            d = targets[:, 3] - targets[:, 1]
-            d /= np.linalg.norm(d, axis=-1, keepdims=True)
-            extra = rng.uniform(-0.03, 0.03, size=(n, 1)) * scale
-            targets += grip
-            targets[:, 2] += d * extra / 2
-            targets[:, 3:] += (d * extra)[:, None]
-        elif acts.start_from_rest:  # pick and place: grasp point, lift height, place point
-            grasp = rng.uniform(-0.01, 0.01, size=(n, 1, 3)) * [1, 1, 0] * scale
-            targets[:, :3] += grasp
-            targets[:, 2:4, 2] += rng.uniform(-0.03, 0.05, size=(n, 1)) * scale
-            r = 0.014 * np.sqrt(rng.uniform(size=n)) * scale
-            phi = rng.uniform(0, 2 * np.pi, size=n)
-            place = np.column_stack([r * np.cos(phi), r * np.sin(phi), np.zeros(n)])
-            targets[:, 4:] += place[:, None]
-        else:  # mug: start, goal and the via points
-            s = rng.uniform(-0.03, 0.03, size=(n, 3)) * [1, 1, 0] * scale
-            g = rng.uniform(-0.03, 0.03, size=(n, 3)) * [1, 1, 0] * scale
-            w = np.linspace(0, 1, targets.shape[1])[None, :, None]
-            targets += (1 - w) * s[:, None] + w * g[:, None]
-            targets[:, 2:5] += rng.uniform(-0.02, 0.02, size=(n, 1, 3)) * scale
+        targets = motion_family(scene.task).perturb(acts.targets[chosen].copy(), acts, rng, scale)
         return targets, start
 
     def generate(self, scene: Scene, generator: str, n: int, seed: int) -> TrajectoryBatch:
@@ -286,14 +151,14 @@ class MotionPlanner:
         acts, anchors, _ = self.prepare(scene)
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(GENERATORS.index(generator),)))
         chosen = self.choose(scene, generator, int(n), rng)
-        targets, start = self.perturb(acts, chosen, rng, scale=1.0)
+        targets, start = self.perturb(scene, acts, chosen, rng, scale=1.0)
         q_keys = self._solve_keyframes(targets, anchors[chosen])
         batch = self._assemble(scene, acts, chosen, targets, q_keys, start)
         meta = {**batch.meta, "generator": generator, "seed": int(seed), "n": int(n)}
         return attrs.evolve(batch, meta=meta)
 
     def _solve_keyframes(self, targets: np.ndarray, seeds: np.ndarray) -> np.ndarray:
-        """Joint keyframes ``[n, K, 7]`` reaching ``targets`` ``[n, K, 3]``, starting from ``seeds``."""
+        """Joint keyframes ``[n, K, dof]`` reaching ``targets`` ``[n, K, 3]``, starting from ``seeds``."""
         shape = seeds.shape
         q, err = self.kin.solve_pointing_down(seeds.reshape(-1, shape[-1]), targets.reshape(-1, 3))
         bad = np.flatnonzero(err > REFINE_TOLERANCE)
@@ -311,36 +176,40 @@ class MotionPlanner:
     def _assemble(self, scene: Scene, acts: ActionSet, chosen: np.ndarray, targets: np.ndarray,
                   q_keys: np.ndarray, start: np.ndarray) -> TrajectoryBatch:
         n = len(chosen)
-        mark = FAMILIES[scene.task]
+        mark = motion_family(scene.task).landmark
         keys = np.concatenate([start[:, None], q_keys], axis=1) if acts.start_from_rest else q_keys
         seg, phase = _blend(acts.times, acts.start_from_rest)
-        q = keys[:, seg] + phase[None, :, None] * (keys[:, seg + 1] - keys[:, seg])  # [n, T, 7]
+        q = keys[:, seg] + phase[None, :, None] * (keys[:, seg + 1] - keys[:, seg])  # [n, T, dof]
         ee, _ = self.kin.fk(q)
         t_on = acts.times[acts.attach]
         t_off = acts.times[acts.detach] if acts.detach is not None else N_STEPS - 1
         follow = np.zeros(N_STEPS, dtype=bool)
         follow[t_on:t_off + 1] = True
         hold = np.arange(N_STEPS) > t_off
-        n_obj = len(scene.objects)
-        objects = np.broadcast_to(np.asarray(scene.positions, dtype=float), (n, N_STEPS, n_obj, 3)).copy()
-        carried = acts.carried[chosen]
-        if mark == "mug":
-            offset = targets[:, 0] - ee[:, t_on]  # the mug's centre where the gripper holds it
-            landmarks = (ee + offset[:, None])[:, :, None, :]
-        else:
-            rows = np.arange(n)
-            initial = objects[rows, 0, carried]  # [n, 3]
-            offset = initial - ee[:, t_on]
-            moved = ee + offset[:, None]  # [n, T, 3]
+
+        def carry(rows: np.ndarray, initial: np.ndarray) -> np.ndarray:
+            """Path ``[len(rows), T, 3]`` of a thing at ``initial`` that keeps its offset to the gripper from
+            grasp (or contact) to release, and stays where it was released."""
+            offset = initial - ee[rows, t_on]
+            moved = ee[rows] + offset[:, None]
             if acts.push:
                 moved[..., 2] = initial[:, None, 2]
             moved = np.where(follow[None, :, None], moved, initial[:, None])
-            moved = np.where(hold[None, :, None], moved[:, t_off][:, None], moved)
-            objects[rows, :, carried] = moved
-            landmarks = np.broadcast_to(np.asarray(scene.landmarks[mark], dtype=float), (n, N_STEPS, 1, 3))
+            return np.where(hold[None, :, None], moved[:, t_off][:, None], moved)
+
+        n_obj = len(scene.objects)
+        objects = np.broadcast_to(np.asarray(scene.positions, dtype=float), (n, N_STEPS, n_obj, 3)).copy()
+        landmarks = np.broadcast_to(np.asarray(scene.landmarks[mark], dtype=float), (n, N_STEPS, 1, 3)).copy()
+        carried = acts.carried[chosen]
+        rows = np.flatnonzero(carried >= 0)
+        if rows.size:
+            objects[rows, :, carried[rows]] = carry(rows, objects[rows, 0, carried[rows]])
+        rows = np.flatnonzero(carried < 0)
+        if rows.size:  # the landmark itself (the mug), grasped where the gripper reaches it
+            landmarks[rows, :, 0] = carry(rows, targets[rows, acts.attach])
         meta = {"robot": self.robot.name, "task": scene.task, "scene_seed": scene.seed,
                 "objects": list(scene.object_names), "relevant": sorted(scene.relevant),
-                "actions": chosen.tolist(), "acted_on": [scene.object_names[c] if c >= 0 else "mug" for c in carried],
+                "actions": chosen.tolist(), "acted_on": [scene.object_names[c] if c >= 0 else mark for c in carried],
                 "action_labels": [acts.labels[a] for a in chosen]}
         return TrajectoryBatch(q, ee, objects, scene.object_names, landmark_positions=landmarks,
                                landmark_names=(mark,), meta=meta)

@@ -1,7 +1,8 @@
 """Drake plants: the arm alone (for inverse kinematics) and full scenes (table, arm, landmarks, objects).
 
 Every position is in metres in the world frame; the table top is the plane z = 0 and the arm base sits
-at the origin. Nothing here loads ``package://`` URIs: all geometry is primitives.
+at its mount pose (default: the origin). The built-in arms and scenes use primitive geometry only; a
+robot's URDF is parsed as it is (see docs/tutorials/robot-plugin.md for what it must satisfy).
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ import numpy as np
 
 from gift.core.data import Appearance, ObjectSpec
 from gift.core.errors import GiftError
-from gift_sim_drake.robots import RobotSpec
+from gift.core.robots import RobotSpec
 
 logging.getLogger("drake").setLevel(logging.ERROR)
 
 from pydrake.geometry import Box, Cylinder, Sphere  # noqa: E402
-from pydrake.math import RigidTransform  # noqa: E402
+from pydrake.math import RigidTransform, RollPitchYaw  # noqa: E402
 from pydrake.multibody.inverse_kinematics import InverseKinematics  # noqa: E402
 from pydrake.multibody.parsing import Parser  # noqa: E402
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction, MultibodyPlant  # noqa: E402
@@ -79,10 +80,25 @@ def _add_visual_collision(plant: MultibodyPlant, body, name: str, shape, pose: R
         plant.RegisterCollisionGeometry(body, pose, shape, f"{name}_collision", CoulombFriction(0.8, 0.6))
 
 
+def mount_pose(spec: RobotSpec) -> RigidTransform:
+    """The pose of the arm's base link in the world (``spec.mount``)."""
+    x, y, z, roll, pitch, yaw = spec.mount
+    return RigidTransform(RollPitchYaw(roll, pitch, yaw), [x, y, z])
+
+
 def add_robot(plant: MultibodyPlant, spec: RobotSpec):
-    """Parse the arm's URDF into ``plant`` and weld its base to the world origin. Returns the model instance."""
-    model = Parser(plant).AddModels(str(spec.urdf_path))[0]
-    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(spec.base_link, model), RigidTransform())
+    """Parse the arm's URDF into ``plant`` and weld its base link at its mount pose. Returns the model instance."""
+    try:
+        models = Parser(plant).AddModels(str(spec.urdf_path))
+    except RuntimeError as e:
+        raise GiftError(f"robot {spec.name!r}: Drake cannot parse {spec.urdf_path}: {e}") from None
+    if len(models) != 1:
+        raise GiftError(f"robot {spec.name!r}: {spec.urdf_path} holds {len(models)} models; a robot URDF holds one")
+    model = models[0]
+    for link in (spec.base_link, spec.ee_link):
+        if not plant.HasFrameNamed(link, model):
+            raise GiftError(f"robot {spec.name!r}: {spec.urdf_path.name} has no link {link!r}")
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(spec.base_link, model), mount_pose(spec))
     return model
 
 
@@ -109,6 +125,15 @@ def add_container(plant: MultibodyPlant, kind: str, center: Sequence[float]) -> 
         _add_visual_collision(plant, body, f"{kind}_{part}", Box(*size), RigidTransform(pos), c["color"])
 
 
+def add_known_landmarks(plant: MultibodyPlant, landmarks: Mapping[str, Sequence[float]]) -> None:
+    """Draw the landmarks this module knows by name: the :data:`CONTAINERS` and the ``spill``."""
+    for name, pos in landmarks.items():
+        if name in CONTAINERS:
+            add_container(plant, name, pos)
+        elif name == "spill":
+            add_spill(plant, pos)
+
+
 def add_spill(plant: MultibodyPlant, center: Sequence[float]) -> None:
     """A flat disc of liquid on the table (visual only)."""
     pose = RigidTransform([float(center[0]), float(center[1]), 0.001])
@@ -125,30 +150,35 @@ def add_free_object(plant: MultibodyPlant, name: str, appearance: Appearance, ma
 
 
 class SceneModel:
-    """A Drake diagram of one scene: table, arm (welded), landmarks and the scene's objects as free bodies.
+    """A Drake diagram of one scene: table, arm (welded at its mount), landmarks and the scene's objects as
+    free bodies.
 
-    ``bodies[name]`` gives each object's body (and ``"mug"`` for the carried mug). Use :meth:`set_state`
-    to pose the arm and the objects, then query ``plant``/``plant_context``. With ``meshcat`` (a
-    ``pydrake.geometry.Meshcat``) the diagram also holds a ``MeshcatVisualizer`` (``visualizer``) that draws
-    the scene on every publish (see :mod:`gift_sim_drake.viewer`).
+    ``bodies[name]`` gives each object's body (and the carried landmark's, e.g. ``"mug"``). The task's motion
+    family (:mod:`gift_sim_drake.families`) draws the static landmarks; a task without one gets the
+    containers and the spill drawn by name. Use :meth:`set_state` to pose the arm and the objects, then query
+    ``plant``/``plant_context``. With ``meshcat`` (a ``pydrake.geometry.Meshcat``) the diagram also holds a
+    ``MeshcatVisualizer`` (``visualizer``) that draws the scene on every publish (see
+    :mod:`gift_sim_drake.viewer`).
     """
 
     def __init__(self, spec: RobotSpec, task: str, objects: Sequence[ObjectSpec],
                  landmarks: Mapping[str, Sequence[float]], meshcat=None) -> None:
+        from gift_sim_drake.families import motion_family, supported_families
+
+        family = motion_family(task) if task in supported_families() else None
         builder = DiagramBuilder()
         self.plant, self.scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
         self.robot = add_robot(self.plant, spec)
         self.spec = spec
         add_table(self.plant)
-        for name, pos in landmarks.items():
-            if name in CONTAINERS:
-                add_container(self.plant, name, pos)
-            elif name == "spill":
-                add_spill(self.plant, pos)
+        if family is not None:
+            family.add_landmarks(self.plant, landmarks)
+        else:
+            add_known_landmarks(self.plant, landmarks)
         self.bodies = {o.name: add_free_object(self.plant, f"object_{i}", o.appearance)
                        for i, o in enumerate(objects)}
-        if task == "place_mug":
-            self.bodies["mug"] = add_free_object(self.plant, "mug", MUG)
+        if family is not None and family.carried_landmark is not None:
+            self.bodies[family.landmark] = add_free_object(self.plant, family.landmark, family.carried_landmark)
         self.plant.Finalize()
         self.visualizer = None
         if meshcat is not None:
@@ -161,7 +191,7 @@ class SceneModel:
         self.ee_frame = self.plant.GetFrameByName(spec.ee_link, self.robot)
 
     def set_state(self, q: np.ndarray, object_positions: Mapping[str, Sequence[float]]) -> None:
-        """Arm joints ``q`` ``[7]`` (rad) and object centres (m, upright)."""
+        """Arm joints ``q`` ``[dof]`` (rad) and object centres (m, upright)."""
         self.plant.SetPositions(self.plant_context, self.robot, np.asarray(q, dtype=float))
         for name, pos in object_positions.items():
             self.plant.SetFreeBodyPose(self.plant_context, self.bodies[name], RigidTransform(np.asarray(pos)))
@@ -195,6 +225,10 @@ class DrakeIK:
         self.plant = MultibodyPlant(0.0)
         self.robot = add_robot(self.plant, spec)
         self.plant.Finalize()
+        if self.plant.num_positions() != len(spec.rest):
+            raise GiftError(f"robot {spec.name!r}: Drake finds {self.plant.num_positions()} joint positions in "
+                            f"{spec.urdf_path.name} but rest has {len(spec.rest)}; every movable joint must lie on "
+                            f"the chain {spec.base_link} -> {spec.ee_link} (make gripper fingers fixed joints)")
         self.ee = self.plant.GetFrameByName(spec.ee_link)
         self.position_tolerance = position_tolerance
         self.angle_tolerance = angle_tolerance
@@ -203,7 +237,7 @@ class DrakeIK:
         self._lock = threading.Lock()
 
     def solve(self, target: Sequence[float], guess: Sequence[float]) -> np.ndarray:
-        """Joint vector ``[7]`` placing the tool centre point at ``target`` (m), approach axis down."""
+        """Joint vector ``[dof]`` placing the tool centre point at ``target`` (m), approach axis down."""
         target = np.asarray(target, dtype=float)
         guess = np.asarray(guess, dtype=float)
         key = (tuple(np.round(target, 4)), tuple(np.round(guess, 6)))
@@ -244,13 +278,13 @@ class DrakeIK:
         return Solve(prog), q
 
 
-_IK: dict[str, DrakeIK] = {}
+_IK: dict[RobotSpec, DrakeIK] = {}
 _IK_LOCK = threading.Lock()
 
 
 def drake_ik(spec: RobotSpec) -> DrakeIK:
     """The process-wide IK solver of an arm (its plant is built once)."""
     with _IK_LOCK:
-        if spec.name not in _IK:
-            _IK[spec.name] = DrakeIK(spec)
-        return _IK[spec.name]
+        if spec not in _IK:
+            _IK[spec] = DrakeIK(spec)
+        return _IK[spec]

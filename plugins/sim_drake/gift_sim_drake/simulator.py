@@ -1,21 +1,23 @@
-"""The Drake simulators ``drake-franka`` and ``drake-jaco``: :class:`gift.core.interfaces.Simulator` on a real
-Drake ``MultibodyPlant`` (scenes, trajectories, features, renders)."""
+"""The Drake simulator, one per registered robot (``drake-franka``, ``drake-jaco``, ``drake-<robot>``):
+:class:`gift.core.interfaces.Simulator` on a real Drake ``MultibodyPlant`` (scenes, trajectories, features,
+renders)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from functools import lru_cache
-from typing import ClassVar
 
 import numpy as np
 
 from gift.core.data import FeatureBatch, ObjectSpec, Scene, TrajectoryBatch
 from gift.core.errors import GiftError
 from gift.core.interfaces import Simulator, Task
+from gift.core.robots import RobotSpec
+from gift_sim_drake.families import N_STEPS, check_scene, supported_families
 from gift_sim_drake.features import compute_features, resolve_task
-from gift_sim_drake.motion import GENERATORS, N_STEPS, MotionPlanner
-from gift_sim_drake.robots import RobotSpec, get_robot
-from gift_sim_drake.scenes import FAMILIES, check_family, layout
+from gift_sim_drake.motion import GENERATORS, MotionPlanner
+from gift_sim_drake.robots import arm_kinematics, get_robot, simulator_name
+from gift_sim_drake.scenes import layout
 
 
 def as_object_specs(objects: Sequence[ObjectSpec | str]) -> tuple[ObjectSpec, ...]:
@@ -37,17 +39,20 @@ REACH_HEIGHTS = np.arange(0.0, 0.81, 0.05)
 @lru_cache(maxsize=None)
 def _reach_curve(robot: RobotSpec) -> np.ndarray:
     """The arm's reach with the gripper pointing down at :data:`REACH_HEIGHTS`, from its kinematics (m)."""
-    return robot.kinematics.reach_pointing_down(REACH_HEIGHTS, robot.rest)
+    return arm_kinematics(robot).reach_pointing_down(REACH_HEIGHTS, np.asarray(robot.rest))
 
 
 class DrakeSimulator(Simulator):
-    """Tabletop scenes of the four task families for one arm, on Drake.
+    """Tabletop scenes of the task families for one arm, on Drake.
 
-    - ``make_scene(task, objects, relevant, seed)``: a randomised layout (:mod:`gift_sim_drake.scenes`) whose
-      objects to be picked lie within this arm's :meth:`reach`;
-      ``scene.landmarks`` holds the family's landmark (``backpack``/``drawer``: the place point inside the
-      container; ``spill``: the spill's centre on the table; ``mug``: the mug's start) and, for place_mug,
-      ``mug_goal``.
+    ``DrakeSimulator(robot)``: ``robot`` is a registered robot's name or a :class:`~gift.core.robots.RobotSpec`
+    (``gift.get_simulator("drake-<robot>")`` builds it for a registered one).
+
+    - ``make_scene(task, objects, relevant, seed)``: a randomised layout from the family's motion family
+      (:mod:`gift_sim_drake.families`; the paper's four in :mod:`gift_sim_drake.tabletop`), objects to be
+      picked within this arm's :meth:`reach`;
+      ``scene.landmarks`` holds the family's landmarks (``backpack``/``drawer``: the place point inside the
+      container; ``spill``: the spill's centre on the table; ``mug``: the mug's start, and ``mug_goal``).
     - ``generate(scene, generator, n, seed)``: ``generator`` in ``("preferred", "default", "random")``
       (:mod:`gift_sim_drake.motion`); every trajectory acts on one thing, named in ``meta["acted_on"]``.
     - ``features(trajectories, task)``: the family's feature columns ``[N, 61, F]``.
@@ -55,21 +60,24 @@ class DrakeSimulator(Simulator):
     - ``replay(scene, clips, ...)``: trajectories of the scene in Drake's Meshcat (:mod:`gift_sim_drake.viewer`).
     """
 
-    robot_name: ClassVar[str] = "franka"
     n_steps = N_STEPS
-    dof = 7
     generators = GENERATORS
-    families = tuple(sorted(FAMILIES))
 
-    def __init__(self, render_cache_dir: str | None = None) -> None:
-        self.robot = get_robot(self.robot_name)
+    def __init__(self, robot: str | RobotSpec, render_cache_dir: str | None = None) -> None:
+        self.robot = get_robot(robot)
+        self.name = simulator_name(self.robot.name)
+        self.dof = arm_kinematics(self.robot).dof
         self.planner = MotionPlanner(self.robot)
         self.render_cache_dir = render_cache_dir
+
+    @property
+    def families(self) -> tuple[str, ...]:
+        """Task families with a registered Drake motion family."""
+        return tuple(supported_families())
 
     def make_scene(self, task: str, objects: Sequence[ObjectSpec | str], relevant: Sequence[str] = (),
                    seed: int = 0) -> Scene:
         family = resolve_task(task)  # unknown names: UnknownComponentError listing the registered families
-        check_family(family.name)
         return layout(family.name, as_object_specs(objects), tuple(relevant), int(seed), reach=self.reach)
 
     def reach(self, heights: np.ndarray) -> np.ndarray:
@@ -87,7 +95,6 @@ class DrakeSimulator(Simulator):
     def scene_model(self, scene: Scene):
         """A Drake diagram of ``scene`` (:class:`gift_sim_drake.plant.SceneModel`): table, this arm, the
         landmarks and the objects as free bodies, e.g. to check a trajectory state on the real plant."""
-        from gift_sim_drake.motion import check_scene
         from gift_sim_drake.plant import SceneModel
 
         check_scene(scene)
@@ -105,16 +112,5 @@ class DrakeSimulator(Simulator):
 
         return render_object(obj, size=size, cache_dir=self.render_cache_dir)
 
-
-class DrakeFranka(DrakeSimulator):
-    """Franka Panda (7-DoF) on a Drake MultibodyPlant: the four task families, features, renders."""
-
-    name = "drake-franka"
-    robot_name = "franka"
-
-
-class DrakeJaco(DrakeSimulator):
-    """Kinova Jaco2 7-DoF (j2s7s300) on a Drake MultibodyPlant: the four task families, features, renders."""
-
-    name = "drake-jaco"
-    robot_name = "jaco"
+    def __repr__(self) -> str:
+        return f"DrakeSimulator({self.robot.name!r})"
