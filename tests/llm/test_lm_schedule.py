@@ -86,13 +86,15 @@ def test_logits_and_choice_probabilities_do_not_depend_on_the_previous_call(embe
 
 @pytest.mark.slow
 @pytest.mark.lm
-def test_few_shot_prompts_reuse_every_shared_message_and_stay_exact(embedded_lm):
+def test_few_shot_prompts_reuse_all_but_the_last_message_and_stay_exact(embedded_lm):
+    """Pieces: the system message, the examples, the question. A prompt that shares everything but the
+    question reuses the examples too; one whose last piece ended inside the examples only the system."""
     target = FEW_SHOT + [{"role": "user", "content": "Is a pear a fruit?"}]
     prompt = embedded_lm.chat_prompt(target)
-    assert len(prompt.starts) == 5
+    assert len(prompt.starts) == 2 and embedded_lm.chat_prompt(target[:1]).starts == ()
     before = {"fresh": None,
               "sibling": FEW_SHOT + [{"role": "user", "content": "Is a cup a fruit?"}],  # all but the last message
-              "shorter": FEW_SHOT[:2],  # its last piece ends inside the cached part: reuse stops before it
+              "shorter": FEW_SHOT[:2],  # its last piece ends inside the examples: reuse stops before it
               "unrelated": UNRELATED}
     got = _situations(embedded_lm, before, lambda: embedded_lm.next_token_logits(prompt))
     assert {k: r for k, (_, r) in got.items()} == {"fresh": 0, "sibling": prompt.starts[-1],

@@ -7,14 +7,14 @@
   reads the next-token distribution (variants such as ``yes``/``Yes``/`` yes`` are summed).
 * Evaluation schedule (:data:`SCHEDULE`): every result is a function of the prompt alone. llama.cpp's
   numbers for a token depend on how the prompt was split into decode batches, so a prompt is always
-  evaluated in the same pieces: each chat message (the messages' start positions come from formatting the
-  message prefixes with the chat template), and the last message with the opened assistant turn, each
-  piece from its own start (in batches of ``n_batch``). The KV cache of the previous call is reused up to
-  the last message start at which the cached pieces and this prompt's pieces agree; the last piece is
+  evaluated in the same pieces, cut at message starts (found by formatting the leading messages with the
+  chat template): the first message, the messages between, and the last message with the opened
+  assistant turn, each piece from its own start (in batches of ``n_batch``). The KV cache of the previous
+  call is reused up to the last cut at which the cached pieces and this prompt's agree; the last piece is
   always evaluated afresh. Both :meth:`LlamaCppLM.choice_probabilities` and :meth:`LlamaCppLM.complete`
-  follow it (``complete`` evaluates up to the last message start itself and lets llama-cpp-python's
-  prefix match evaluate the rest in one piece). ``identity()`` names the schedule, so cached answers of
-  another schedule are never mixed in.
+  follow it (``complete`` evaluates up to the last cut itself and lets llama-cpp-python's prefix match
+  evaluate the rest in one piece). ``identity()`` names the schedule, so cached answers of another
+  schedule are never mixed in.
 
 One :class:`llama_cpp.Llama` is loaded per (model path, n_ctx) per process and shared by every backend
 instance on that file; calls to it are serialised by a lock.
@@ -55,8 +55,11 @@ log = logging.getLogger(__name__)
 
 #: How prompts are split into decode batches and which KV-cache entries are reused (see the module
 #: docstring). Part of :meth:`LlamaCppLM.identity`, so caches keyed by it never mix answers computed under
-#: different schedules; change it whenever the split changes. ``msg1``: one piece per chat message, the
-#: last message with the generation prompt, KV reuse only up to a message start.
+#: different schedules; change it whenever the split changes. ``msg1``: pieces cut at the second and at
+#: the last message's start, KV reuse only up to a cut. (Not one piece per message: every decode call
+#: costs about 0.19 CPU-s on top of its tokens, so a 10-message few-shot prompt evaluated fresh took 7.2
+#: CPU-s in 10 pieces against 6.2 in 3 and 5.5 in one, while gift's calls reuse nothing between the
+#: first and the last message; docs/performance.md.)
 SCHEDULE = "msg1"
 
 _MODELS: dict[tuple[str, int], tuple[Any, threading.RLock]] = {}
@@ -184,12 +187,12 @@ def _close_all() -> None:
 def _is_increasing(instance: Any, attribute: Any, starts: tuple[int, ...]) -> None:
     n = len(instance.tokens)
     if any(not 0 < a < n for a in starts) or list(starts) != sorted(set(starts)):
-        raise ValueError(f"ChatPrompt: message starts {starts} must increase strictly within (0, {n})")
+        raise ValueError(f"ChatPrompt: cuts {starts} must increase strictly within (0, {n})")
 
 
 @attrs.frozen
 class ChatPrompt:
-    """A chat prompt as tokens, with the token index where each message after the first starts.
+    """A chat prompt as tokens, with the token indices where its evaluation pieces start (message starts).
 
     ``tokens``: the formatted prompt (assistant turn opened), ``[n]``. ``starts``: strictly increasing
     indices in ``(0, n)``; the prompt is evaluated in the pieces ``[0, s1), [s1, s2), ..., [s_last, n)``
@@ -201,7 +204,7 @@ class ChatPrompt:
 
     @property
     def ends(self) -> tuple[int, ...]:
-        """End index of every piece (the message starts and the prompt's length)."""
+        """End index of every piece (the cuts and the prompt's length)."""
         return (*self.starts, len(self.tokens))
 
 
@@ -219,9 +222,8 @@ def _common_prefix(cached: np.ndarray, tokens: Sequence[int]) -> int:
 
 
 def reusable_prefix(cached_ends: Sequence[int], starts: Sequence[int], common: int) -> int:
-    """Tokens of the KV cache a prompt may keep: its largest message start ``s`` such that the cached pieces
-    ended exactly at this prompt's message starts up to ``s`` and the first ``common >= s`` tokens agree
-    (0 when none). The KV entries before ``s`` are then what evaluating the prompt afresh would compute."""
+    """Tokens of the KV cache a prompt may keep: its largest cut ``s`` such that the cached pieces ended
+    exactly at this prompt's cuts up to ``s`` and the first ``common >= s`` tokens agree (0 when none). The KV entries before ``s`` are then what evaluating the prompt afresh would compute."""
     keep = 0
     for cached, start in zip(cached_ends, starts):
         if cached != start or start > common:
@@ -252,7 +254,7 @@ class LlamaCppLM(LMBackend):
         self.n_ctx = int(n_ctx)
         if self.n_ctx < 256:
             raise LMError(f"llamacpp: n_ctx={n_ctx} is too small (use at least 256)")
-        #: Reuse the KV cache of the previous call up to a shared message start (False: evaluate every prompt
+        #: Reuse the KV cache of the previous call up to a shared cut (False: evaluate every prompt
         #: from its first token; the same pieces, so the same numbers).
         self.reuse_prefix = bool(reuse_prefix)
         #: Prompt tokens taken from the KV cache in the last call (:meth:`complete` or :meth:`next_token_logits`).
@@ -341,25 +343,26 @@ class LlamaCppLM(LMBackend):
         return self.llama.tokenize(res.prompt.encode("utf-8"), add_bos=not res.added_special, special=True), res
 
     def chat_prompt(self, messages: Sequence[Message]) -> ChatPrompt:
-        """The chat-formatted prompt (assistant turn opened) as tokens, with its message starts.
+        """The chat-formatted prompt (assistant turn opened) as tokens, cut where the second and the last
+        message start.
 
         A message starts where the template's formatting of the messages before it (without a generation
-        prompt) ends, provided those tokens are a prefix of the prompt's; if that fails for any message, the
-        prompt is one piece (evaluated whole every time).
+        prompt) ends, provided those tokens are a prefix of the prompt's; if that fails, the prompt is one
+        piece (evaluated whole every time).
         """
         formatters = self._formatters()
         if formatters is None:
             raise LMError(f"llamacpp {self.model}: the GGUF has no chat template; choice_probabilities needs one")
         dicts = message_dicts(messages)
         tokens, _ = self._format(formatters[0], dicts)
-        return ChatPrompt(tokens, self._message_starts(formatters[1], dicts, tokens))
+        return ChatPrompt(tokens, self._cuts(formatters[1], dicts, tokens))
 
-    def _message_starts(self, formatter: Any, dicts: list[dict[str, str]], tokens: list[int]) -> tuple[int, ...]:
+    def _cuts(self, formatter: Any, dicts: list[dict[str, str]], tokens: list[int]) -> tuple[int, ...]:
         llama = self.llama
         if getattr(llama, "_is_recurrent", False) or getattr(llama, "_is_hybrid", False):
             return ()  # a recurrent state cannot be cut back to a message start
         starts: list[int] = []
-        for k in range(1, len(dicts)):
+        for k in (k for k in sorted({1, len(dicts) - 1}) if 0 < k < len(dicts)):  # the second, the last message
             prefix, _ = self._format(formatter, dicts[:k])
             n = len(prefix)
             if not (starts[-1] if starts else 0) < n < len(tokens) or prefix != tokens[:n]:
@@ -422,9 +425,9 @@ class LlamaCppLM(LMBackend):
                 else:
                     dicts = message_dicts(messages)
                     tokens, res = self._format(formatters[0], dicts)
-                    prompt = ChatPrompt(tokens, self._message_starts(formatters[1], dicts, tokens))
+                    prompt = ChatPrompt(tokens, self._cuts(formatters[1], dicts, tokens))
                     self._check_fits(prompt)
-                    # Evaluate up to the last message start here; generate() then finds exactly these tokens
+                    # Evaluate up to the last cut here; generate() then finds exactly these tokens
                     # in the context (its longest prefix match stops there) and evaluates the last piece in
                     # one call, then one token per step.
                     self._evaluate(prompt, upto=prompt.starts[-1] if prompt.starts else 0)
@@ -447,7 +450,7 @@ class LlamaCppLM(LMBackend):
 
     def next_token_logits(self, prompt: ChatPrompt | Sequence[int]) -> np.ndarray:
         """Logits ``[vocab]`` of the token after ``prompt``, evaluated by the schedule: KV entries up to a
-        shared message start are reused, the last piece is evaluated afresh. Bare token ids are one piece."""
+        shared cut are reused, the last piece is evaluated afresh. Bare token ids are one piece."""
         if not isinstance(prompt, ChatPrompt):
             prompt = ChatPrompt(prompt)
         if not prompt.tokens:
