@@ -22,6 +22,8 @@ Run: ``.venv/bin/python -m pytest tests/benchmarks/test_llm_benchmark.py``.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -64,9 +66,11 @@ def backends():
     from gift_llm.backends.llamacpp import LlamaCppLM
 
     shared = get_default_lm(cache=False).inner
-    pieces = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, reuse_prefix=False)
-    assert pieces.llama is shared.llama  # the same loaded model
-    return {"reuse": shared, "pieces": pieces}
+    # the same loaded model on one thread, so that CPU seconds compare the schedules, not thread counts
+    reuse = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, n_threads=1)
+    pieces = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, n_threads=1, reuse_prefix=False)
+    assert reuse.llama is pieces.llama is shared.llama
+    return {"reuse": reuse, "pieces": pieces}
 
 
 @pytest.fixture(scope="module")
@@ -93,16 +97,23 @@ def expected(backends, prompts):
 @pytest.mark.benchmark(group="llm-prefix")
 @pytest.mark.parametrize("variant", ["one-batch", "pieces", "token-prefix", "reuse"])
 def test_prefix_reuse(benchmark, backends, prompts, expected, variant):
-    lm = backends["reuse"]
-    lm.llama.reset()
-    out = benchmark.pedantic(_evaluate_all, args=(backends, prompts, variant), rounds=2, iterations=1,
-                             warmup_rounds=0)
+    backends["reuse"].llama.reset()
+    cpu: list[float] = []
+
+    def timed():  # CPU seconds too: on a shared machine they vary less than wall time
+        c0 = time.process_time()
+        out = _evaluate_all(backends, prompts, variant)
+        cpu.append(time.process_time() - c0)
+        return out
+
+    out = benchmark.pedantic(timed, rounds=2, iterations=1, warmup_rounds=0)
     for got, ref in zip(out, expected):
         if variant in ("pieces", "reuse"):
             np.testing.assert_array_equal(got, ref)  # the schedule: the same numbers with or without reuse
         else:
             assert np.abs(got - ref).max() < 1.0  # another split into decode batches: close, not equal
             assert int(np.argmax(got)) == int(np.argmax(ref))
+    benchmark.extra_info["cpu_s_per_round"] = [round(c, 2) for c in cpu]
     benchmark.extra_info["prompts_per_round"] = len(prompts)
     benchmark.extra_info["prompt_tokens_per_round"] = sum(len(p.tokens) for p in prompts)
     if variant == "reuse":
