@@ -69,15 +69,6 @@ def _lm_kind(messages) -> str:
     return "other"
 
 
-def _common_prefix(a, b) -> int:
-    n = 0
-    for x, y in zip(a, b):
-        if x != y:
-            break
-        n += 1
-    return n
-
-
 def _instrument() -> None:
     from gift_llm.backends import llamacpp
 
@@ -85,16 +76,11 @@ def _instrument() -> None:
     orig_choices = llamacpp.LlamaCppLM.choice_probabilities
 
     def complete(self, messages, **kw):
-        llama = self.llama
-        with self._lock:
-            before = llama._input_ids[: llama.n_tokens].tolist()  # noqa: SLF001
-            prompt = self._prompt_tokens(messages)
         t0, c0 = time.perf_counter(), time.process_time()
         out = orig_complete(self, messages, **kw)
         dt, cpu = time.perf_counter() - t0, time.process_time() - c0
-        reused = min(_common_prefix(before, prompt), max(len(prompt) - 1, 0)) if self.reuse_prefix else 0
         LM_CALLS.append({"kind": _lm_kind(messages), "method": "complete", "prompt_tokens": out.usage.prompt_tokens,
-                         "reused_tokens": reused, "answer_tokens": out.usage.completion_tokens, "seconds": dt,
+                         "reused_tokens": self.last_reused_tokens, "answer_tokens": out.usage.completion_tokens, "seconds": dt,
                          "cpu_s": cpu, "threads": self.last_threads, "json": kw.get("json_schema") is not None})
         return out
 

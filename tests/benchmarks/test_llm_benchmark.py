@@ -1,8 +1,19 @@
-"""LM plugin speed: prompt-prefix reuse in llama.cpp, and the SQLite cache, each against its naive baseline.
+"""LM plugin speed: the llamacpp evaluation schedule with prompt-prefix reuse, and the SQLite cache, each
+against its naive baseline in the same run.
 
-- ``prefix``: yes/no ``choice_probabilities`` of the embedded model for questions that share a long system
-  prompt (237-token prompts, 224 tokens shared) — KV-cache reuse of the shared prefix (``reuse_prefix=True``, the default) vs
-  re-evaluating the whole prompt every call (``reuse_prefix=False``).
+- ``prefix``: ``choice_probabilities``-style next-token logits of the embedded model for yes/no questions
+  that share a long system message (4 prompts of about 240 tokens) and two few-shot prompts of the
+  category kind (system message, two answered examples, a question). Variants:
+
+  * ``reuse`` (the default, :data:`gift_llm.backends.llamacpp.SCHEDULE`): the prompt cut into pieces at
+    the second and the last message's start, the KV cache reused up to the last cut shared with the
+    previous prompt;
+  * ``pieces``: the same pieces, every prompt evaluated from its first token (``reuse_prefix=False``);
+    must give the same logits to the last bit;
+  * ``one-batch``: every prompt evaluated whole, in one piece (the no-reuse evaluation before the
+    schedule); logits differ slightly (another split into decode batches);
+  * ``token-prefix``: the schedule before ``msg1``: the KV cache reused up to the longest shared token
+    prefix, whatever the split (results depend on the previous call).
 - ``cache``: the same questions answered from the persistent cache vs by the model.
 
 Nothing here asserts anything about time; each benchmark checks its answers against the baseline's.
@@ -11,6 +22,9 @@ Run: ``.venv/bin/python -m pytest tests/benchmarks/test_llm_benchmark.py``.
 
 from __future__ import annotations
 
+import time
+
+import numpy as np
 import pytest
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm]
@@ -20,6 +34,30 @@ SYSTEM = ("You help a household robot decide which objects matter for a task. Th
     + "Answer with yes or no only."
 QUESTIONS = [f"Should the robot keep the {o} away from the open water bottle?"
              for o in ("laptop", "phone", "apple", "sponge")]
+FEW_SHOT_SYSTEM = "You name the kind of objects a goal is about, in a few words."
+EXAMPLES = [("Put the apples and pears in the bowl.", "fruit"), ("Keep the knives away from the baby.", "sharp tools")]
+GOALS = ["Move the laptop away from the water.", "Stack the plates and the cups."]
+
+
+def _conversations() -> list[list[dict[str, str]]]:
+    yes_no = [[{"role": "system", "content": SYSTEM}, {"role": "user", "content": q}] for q in QUESTIONS]
+    shots = [{"role": "system", "content": FEW_SHOT_SYSTEM}]
+    for goal, answer in EXAMPLES:
+        shots += [{"role": "user", "content": f"Goal: {goal}"}, {"role": "assistant", "content": answer}]
+    return yes_no + [shots + [{"role": "user", "content": f"Goal: {g}"}] for g in GOALS]
+
+
+def _token_prefix_logits(lm, tokens) -> np.ndarray:
+    """The evaluation before the schedule: keep the longest shared token prefix, evaluate the rest at once."""
+    llama = lm.llama
+    keep = 0
+    for a, b in zip(llama.input_ids[: llama.n_tokens].tolist(), tokens):
+        if a != b:
+            break
+        keep += 1
+    llama.n_tokens = min(keep, len(tokens) - 1)
+    llama.eval(list(tokens[llama.n_tokens:]))
+    return np.array(np.ctypeslib.as_array(llama._ctx.get_logits(), shape=(llama.n_vocab(),)), dtype=np.float64)
 
 
 @pytest.fixture(scope="module")
@@ -28,30 +66,62 @@ def backends():
     from gift_llm.backends.llamacpp import LlamaCppLM
 
     shared = get_default_lm(cache=False).inner
-    naive = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, reuse_prefix=False)  # same loaded Llama
-    return {"reuse": shared, "naive": naive}
+    # the same loaded model on one thread, so that CPU seconds compare the schedules, not thread counts
+    reuse = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, n_threads=1)
+    pieces = LlamaCppLM(shared.path, n_ctx=shared.n_ctx, n_threads=1, reuse_prefix=False)
+    assert reuse.llama is pieces.llama is shared.llama
+    return {"reuse": reuse, "pieces": pieces}
 
 
 @pytest.fixture(scope="module")
-def expected(backends):
-    """Answers of the naive baseline, computed once."""
-    return _ask_all(backends["naive"])
+def prompts(backends):
+    return [backends["reuse"].chat_prompt(c) for c in _conversations()]
 
 
-def _ask_all(lm):
-    return [lm.choice_probabilities([{"role": "system", "content": SYSTEM}, {"role": "user", "content": q}],
-                                    ["yes", "no"]) for q in QUESTIONS]
+def _evaluate_all(backends, prompts, variant) -> list[np.ndarray]:
+    lm = backends["pieces" if variant == "pieces" else "reuse"]
+    with lm._lock:  # one lock per loaded model: no other call between the prompts
+        if variant == "one-batch":
+            return [lm.next_token_logits(list(p.tokens)) for p in prompts]  # bare tokens: one piece, no reuse
+        if variant == "token-prefix":
+            return [_token_prefix_logits(lm, p.tokens) for p in prompts]
+        return [lm.next_token_logits(p) for p in prompts]
+
+
+@pytest.fixture(scope="module")
+def expected(backends, prompts):
+    """Logits of the ``pieces`` baseline, computed once."""
+    return _evaluate_all(backends, prompts, "pieces")
 
 
 @pytest.mark.benchmark(group="llm-prefix")
-@pytest.mark.parametrize("variant", ["naive", "reuse"])
-def test_prefix_reuse(benchmark, backends, expected, variant):
-    lm = backends[variant]
-    out = benchmark.pedantic(_ask_all, args=(lm,), rounds=2, iterations=1, warmup_rounds=0)
+@pytest.mark.parametrize("variant", ["one-batch", "pieces", "token-prefix", "reuse"])
+def test_prefix_reuse(benchmark, backends, prompts, expected, variant):
+    backends["reuse"].llama.reset()
+    cpu: list[float] = []
+
+    def timed():  # CPU seconds too: on a shared machine they vary less than wall time
+        c0 = time.process_time()
+        out = _evaluate_all(backends, prompts, variant)
+        cpu.append(time.process_time() - c0)
+        return out
+
+    out = benchmark.pedantic(timed, rounds=2, iterations=1, warmup_rounds=0)
     for got, ref in zip(out, expected):
-        assert got["yes"] == pytest.approx(ref["yes"], abs=0.02)
-    benchmark.extra_info["questions_per_round"] = len(QUESTIONS)
-    benchmark.extra_info["reused_prompt_tokens_last_call"] = lm.last_reused_tokens
+        if variant in ("pieces", "reuse"):
+            np.testing.assert_array_equal(got, ref)  # the schedule: the same numbers with or without reuse
+        else:
+            assert np.abs(got - ref).max() < 1.0  # another split into decode batches: close, not equal
+            assert int(np.argmax(got)) == int(np.argmax(ref))
+    benchmark.extra_info["cpu_s_per_round"] = [round(c, 2) for c in cpu]
+    benchmark.extra_info["prompts_per_round"] = len(prompts)
+    benchmark.extra_info["prompt_tokens_per_round"] = sum(len(p.tokens) for p in prompts)
+    if variant == "reuse":
+        benchmark.extra_info["reused_tokens_per_round"] = sum(p.starts[-1] for p in prompts[1:])
+
+
+def _ask_all(lm):
+    return [lm.choice_probabilities(c, ["yes", "no"]) for c in _conversations()[: len(QUESTIONS)]]
 
 
 @pytest.mark.benchmark(group="llm-cache")
@@ -62,6 +132,6 @@ def test_cache_vs_model(benchmark, backends, variant, tmp_path):
     lm = CachedLM(backends["reuse"], path=tmp_path / "c.sqlite", enabled=variant == "cache")
     filled = _ask_all(lm)  # fills the cache in the cached variant
     out = benchmark.pedantic(_ask_all, args=(lm,), rounds=2, iterations=1, warmup_rounds=0)
-    assert out == filled or variant == "model"
+    assert out == filled  # the schedule makes the model's answers repeatable too
     if variant == "cache":
         assert lm.stats.calls == len(QUESTIONS)  # only the filling round reached the model

@@ -20,7 +20,7 @@ def test_complete_answers_a_trivial_question(embedded_lm):
                              max_tokens=5)
     assert "4" in c.text
     assert c.usage.prompt_tokens > 5 and 1 <= c.usage.completion_tokens <= 5 and c.usage.latency_s > 0
-    assert c.model == "llamacpp:qwen2.5-coder-1.5b-instruct-q4_k_m.gguf"
+    assert c.model == f"llamacpp:qwen2.5-coder-1.5b-instruct-q4_k_m.gguf+{llamacpp.SCHEDULE}"
 
 
 def test_choice_probabilities_separate_true_from_false(embedded_lm):

@@ -70,14 +70,13 @@ def test_bad_thread_count_is_a_clear_error(tmp_path):
 @pytest.mark.slow
 @pytest.mark.lm
 def test_thread_count_does_not_change_a_bit_of_the_logits(embedded_lm):
-    """The same prompt on 1 and on 2 threads gives identical logits, evaluated fresh and with a prefix reused
-    from the KV cache. (Fresh and reused differ from each other: llama.cpp's result depends on how the prompt
-    is split into decode batches; see docs/performance.md.)"""
+    """The same prompt on 1 and on 2 threads gives identical logits, evaluated fresh and with the system
+    message reused from the KV cache (and, by the evaluation schedule, fresh and reused agree too)."""
     system = {"role": "system", "content": "You answer questions about everyday objects with a single word: yes or no."}
     msgs = [system, {"role": "user", "content": "Is a paintbrush (a tool for applying paint) one of the art "
                                                 "supplies? Answer yes or no."}]
     other = [system, {"role": "user", "content": "Is a stapler one of the art supplies? Answer yes or no."}]
-    tokens = embedded_lm._prompt_tokens(msgs)
+    prompt = embedded_lm.chat_prompt(msgs)
     saved = embedded_lm._fixed_threads
     fresh, reused = {}, {}
     try:
@@ -85,15 +84,15 @@ def test_thread_count_does_not_change_a_bit_of_the_logits(embedded_lm):
             embedded_lm._fixed_threads = n
             with embedded_lm._lock:
                 embedded_lm.llama.reset()
-                fresh.setdefault(n, []).append(embedded_lm.next_token_logits(tokens))
+                fresh.setdefault(n, []).append(embedded_lm.next_token_logits(prompt))
                 assert embedded_lm.last_reused_tokens == 0
                 embedded_lm.llama.reset()
-                embedded_lm.next_token_logits(embedded_lm._prompt_tokens(other))  # shares the system prefix
-                reused.setdefault(n, []).append(embedded_lm.next_token_logits(tokens))
-                assert embedded_lm.last_reused_tokens > 10
+                embedded_lm.next_token_logits(embedded_lm.chat_prompt(other))  # shares the system prefix
+                reused.setdefault(n, []).append(embedded_lm.next_token_logits(prompt))
+                assert embedded_lm.last_reused_tokens == prompt.starts[0] > 10
             assert embedded_lm.last_threads == n
     finally:
         embedded_lm._fixed_threads = saved
     for got in (fresh, reused):
-        np.testing.assert_array_equal(got[2][0], got[1][0])
-        np.testing.assert_array_equal(got[1][1], got[1][0])
+        np.testing.assert_array_equal(got[2][0], fresh[1][0])
+        np.testing.assert_array_equal(got[1][1], fresh[1][0])

@@ -6,8 +6,16 @@
   JSON-object grammar).
 * :meth:`LlamaCppLM.choice_probabilities` evaluates the chat prompt with the assistant turn opened and
   reads the next-token distribution (variants such as ``yes``/``Yes``/`` yes`` are summed).
-* Prompt-prefix reuse: both paths keep the evaluated tokens in the KV cache, and the next call only
-  evaluates the suffix after the longest shared token prefix.
+* Evaluation schedule (:data:`SCHEDULE`): every result is a function of the prompt alone. llama.cpp's
+  numbers for a token depend on how the prompt was split into decode batches, so a prompt is always
+  evaluated in the same pieces, cut at message starts (found by formatting the leading messages with the
+  chat template): the first message, the messages between, and the last message with the opened
+  assistant turn, each piece from its own start (in batches of ``n_batch``). The KV cache of the previous
+  call is reused up to the last cut at which the cached pieces and this prompt's agree; the last piece is
+  always evaluated afresh. Both :meth:`LlamaCppLM.choice_probabilities` and :meth:`LlamaCppLM.complete`
+  follow it (``complete`` evaluates up to the last cut itself and lets llama-cpp-python's prefix match
+  evaluate the rest in one piece). ``identity()`` names the schedule, so cached answers of another
+  schedule are never mixed in.
 
 One :class:`llama_cpp.Llama` is loaded per (model path, n_ctx) per process and shared by every backend
 instance on that file; calls to it are serialised by a lock.
@@ -26,20 +34,34 @@ from __future__ import annotations
 
 import atexit
 import json
+import logging
 import math
 import os
 import threading
 import time
+import weakref
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, ClassVar
 
+import attrs
 import numpy as np
 
 from gift.core.data import Completion, Message, Usage
 from gift.core.errors import LMError
 from gift.core.interfaces import LMBackend
 from gift_llm.backends.common import first_token_ids, message_dicts, probabilities_from_logits
+
+log = logging.getLogger(__name__)
+
+#: How prompts are split into decode batches and which KV-cache entries are reused (see the module
+#: docstring). Part of :meth:`LlamaCppLM.identity`, so caches keyed by it never mix answers computed under
+#: different schedules; change it whenever the split changes. ``msg1``: pieces cut at the second and at
+#: the last message's start, KV reuse only up to a cut. (Not one piece per message: every decode call
+#: costs about 0.19 CPU-s on top of its tokens, so a 10-message few-shot prompt evaluated fresh took 7.2
+#: CPU-s in 10 pieces against 6.2 in 3 and 5.5 in one, while gift's calls reuse nothing between the
+#: first and the last message; docs/performance.md.)
+SCHEDULE = "msg1"
 
 _MODELS: dict[tuple[str, int], tuple[Any, threading.RLock]] = {}
 _MODELS_LOCK = threading.Lock()
@@ -163,6 +185,54 @@ def _close_all() -> None:
         _MODELS.clear()
 
 
+def _is_increasing(instance: Any, attribute: Any, starts: tuple[int, ...]) -> None:
+    n = len(instance.tokens)
+    if any(not 0 < a < n for a in starts) or list(starts) != sorted(set(starts)):
+        raise ValueError(f"ChatPrompt: cuts {starts} must increase strictly within (0, {n})")
+
+
+@attrs.frozen
+class ChatPrompt:
+    """A chat prompt as tokens, with the token indices where its evaluation pieces start (message starts).
+
+    ``tokens``: the formatted prompt (assistant turn opened), ``[n]``. ``starts``: strictly increasing
+    indices in ``(0, n)``; the prompt is evaluated in the pieces ``[0, s1), [s1, s2), ..., [s_last, n)``
+    (empty ``starts``: one piece, never reused).
+    """
+
+    tokens: tuple[int, ...] = attrs.field(converter=tuple)
+    starts: tuple[int, ...] = attrs.field(converter=tuple, default=(), validator=_is_increasing)
+
+    @property
+    def ends(self) -> tuple[int, ...]:
+        """End index of every piece (the cuts and the prompt's length)."""
+        return (*self.starts, len(self.tokens))
+
+
+#: Per shared ``Llama``: the end index of every piece evaluated into its KV cache by this module, in order.
+#: Valid only up to the tokens the context still holds (``llama.n_tokens``); read and written under the
+#: model's lock. Every evaluation on a shared ``Llama`` goes through :class:`LlamaCppLM`.
+_PIECES: weakref.WeakKeyDictionary[Any, tuple[int, ...]] = weakref.WeakKeyDictionary()
+
+
+def _common_prefix(cached: np.ndarray, tokens: Sequence[int]) -> int:
+    """Length of the longest common prefix of the cached token ids and ``tokens``."""
+    n = min(len(cached), len(tokens))
+    differ = np.flatnonzero(np.asarray(cached[:n]) != np.asarray(tokens[:n], dtype=cached.dtype))
+    return int(differ[0]) if differ.size else n
+
+
+def reusable_prefix(cached_ends: Sequence[int], starts: Sequence[int], common: int) -> int:
+    """Tokens of the KV cache a prompt may keep: its largest cut ``s`` such that the cached pieces ended
+    exactly at this prompt's cuts up to ``s`` and the first ``common >= s`` tokens agree (0 when none). The KV entries before ``s`` are then what evaluating the prompt afresh would compute."""
+    keep = 0
+    for cached, start in zip(cached_ends, starts):
+        if cached != start or start > common:
+            break
+        keep = start
+    return keep
+
+
 class LlamaCppLM(LMBackend):
     """In-process GGUF model through llama-cpp-python (grammar-constrained JSON, log-probabilities).
 
@@ -185,9 +255,10 @@ class LlamaCppLM(LMBackend):
         self.n_ctx = int(n_ctx)
         if self.n_ctx < 256:
             raise LMError(f"llamacpp: n_ctx={n_ctx} is too small (use at least 256)")
-        #: Keep the KV cache of the previous call and evaluate only the new suffix (False: re-evaluate all).
+        #: Reuse the KV cache of the previous call up to a shared cut (False: evaluate every prompt
+        #: from its first token; the same pieces, so the same numbers).
         self.reuse_prefix = bool(reuse_prefix)
-        #: Prompt tokens taken from the KV cache in the last :meth:`next_token_logits` call.
+        #: Prompt tokens taken from the KV cache in the last call (:meth:`complete` or :meth:`next_token_logits`).
         self.last_reused_tokens = 0
         self._opts = dict(n_ctx=self.n_ctx, n_threads=n_threads, n_batch=n_batch, seed=seed, verbose=verbose)
         if n_threads is not None and int(n_threads) < 1:
@@ -213,7 +284,8 @@ class LlamaCppLM(LMBackend):
         return self._llama
 
     def identity(self) -> str:
-        return f"{self.name}:{self.model}"
+        """``llamacpp:<model file name>+<schedule>``: the schedule changes the numbers, so it keys caches too."""
+        return f"{self.name}:{self.model}+{SCHEDULE}"
 
     def _set_threads(self, llama: Any) -> int:
         """Set the shared context's threads for this call (caller holds the lock); returns the count."""
@@ -249,13 +321,91 @@ class LlamaCppLM(LMBackend):
                 raise LMError(f"llamacpp: cannot build a grammar from the JSON schema {key[:200]}: {e}") from e
         return self._grammars[key]
 
+    # ------------------------------------------------------------------ evaluation schedule
+    def _formatters(self) -> tuple[Any, Any] | None:
+        """Chat formatters of the GGUF's template (assistant turn opened, and not), None without a template."""
+        if self._formatter is None:
+            llama = self.llama
+            template = llama.metadata.get("tokenizer.chat_template")
+            if not template:
+                return None
+            from llama_cpp.llama_chat_format import Jinja2ChatFormatter
+
+            eos, bos = llama.token_eos(), llama.token_bos()
+            text_of = llama._model.token_get_text  # noqa: SLF001 - same helper Llama uses for its templates
+            opts = dict(template=template, eos_token=text_of(eos) if eos != -1 else "",
+                        bos_token=text_of(bos) if bos != -1 else "", stop_token_ids=[eos] if eos != -1 else None)
+            self._formatter = (Jinja2ChatFormatter(add_generation_prompt=True, **opts),
+                               Jinja2ChatFormatter(add_generation_prompt=False, **opts))
+        return self._formatter
+
+    def _format(self, formatter: Any, messages: list[dict[str, str]]) -> tuple[list[int], Any]:
+        res = formatter(messages=messages)
+        return self.llama.tokenize(res.prompt.encode("utf-8"), add_bos=not res.added_special, special=True), res
+
+    def chat_prompt(self, messages: Sequence[Message]) -> ChatPrompt:
+        """The chat-formatted prompt (assistant turn opened) as tokens, cut where the second and the last
+        message start.
+
+        A message starts where the template's formatting of the messages before it (without a generation
+        prompt) ends, provided those tokens are a prefix of the prompt's; if that fails, the prompt is one
+        piece (evaluated whole every time).
+        """
+        formatters = self._formatters()
+        if formatters is None:
+            raise LMError(f"llamacpp {self.model}: the GGUF has no chat template; choice_probabilities needs one")
+        dicts = message_dicts(messages)
+        tokens, _ = self._format(formatters[0], dicts)
+        return ChatPrompt(tokens, self._cuts(formatters[1], dicts, tokens))
+
+    def _cuts(self, formatter: Any, dicts: list[dict[str, str]], tokens: list[int]) -> tuple[int, ...]:
+        llama = self.llama
+        if getattr(llama, "_is_recurrent", False) or getattr(llama, "_is_hybrid", False):
+            return ()  # a recurrent state cannot be cut back to a message start
+        starts: list[int] = []
+        for k in (k for k in sorted({1, len(dicts) - 1}) if 0 < k < len(dicts)):  # the second, the last message
+            prefix, _ = self._format(formatter, dicts[:k])
+            n = len(prefix)
+            if not (starts[-1] if starts else 0) < n < len(tokens) or prefix != tokens[:n]:
+                log.debug("llamacpp %s: message %d does not start at a token boundary of the prompt; "
+                          "evaluating the prompt whole", self.model, k)
+                return ()
+            starts.append(n)
+        return tuple(starts)
+
+    def _check_fits(self, prompt: ChatPrompt) -> None:
+        if len(prompt.tokens) >= self.n_ctx:
+            raise LMError(f"llamacpp {self.model}: prompt of {len(prompt.tokens)} tokens does not fit "
+                          f"n_ctx={self.n_ctx} (raise it with n_ctx=...)")
+
+    def _evaluate(self, prompt: ChatPrompt, *, upto: int) -> int:
+        """Bring the KV cache to ``prompt.tokens[:upto]`` (``upto``: a piece end) following the schedule;
+        returns the tokens kept from the cache. The caller holds the lock."""
+        llama = self.llama
+        keep = 0
+        if self.reuse_prefix:
+            cached = llama.input_ids[: llama.n_tokens]
+            keep = reusable_prefix(_PIECES.get(llama, ()), prompt.starts, _common_prefix(cached, prompt.tokens))
+        if keep == 0:
+            llama.reset()
+        llama.n_tokens = keep  # eval() drops the KV entries from n_tokens on
+        done = [e for e in prompt.ends if e <= keep]
+        _PIECES[llama] = tuple(done)
+        for end in prompt.ends:
+            if keep < end <= upto:
+                llama.eval(list(prompt.tokens[llama.n_tokens:end]))
+                done.append(end)
+                _PIECES[llama] = tuple(done)
+        self.last_reused_tokens = keep
+        return keep
+
     # ------------------------------------------------------------------ complete
     def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,
                  max_tokens: int = 512, stop: Sequence[str] | None = None,
                  json_schema: Mapping[str, Any] | None = None) -> Completion:
         llama = self.llama
-        kwargs: dict[str, Any] = dict(messages=message_dicts(messages), temperature=float(temperature),
-                                      max_tokens=int(max_tokens), stop=list(stop) if stop else None)
+        kwargs: dict[str, Any] = dict(temperature=float(temperature), max_tokens=int(max_tokens),
+                                      top_p=0.95, top_k=40, min_p=0.05, typical_p=1.0, repeat_penalty=1.0)
         if seed is not None:
             kwargs["seed"] = int(seed)
         if json_schema is not None:
@@ -263,16 +413,33 @@ class LlamaCppLM(LMBackend):
         assert self._lock is not None
         t0 = time.perf_counter()
         with self._lock:
-            if not self.reuse_prefix:
-                llama.reset()
             self._set_threads(llama)
+            formatters = self._formatters()
             try:
-                out = llama.create_chat_completion(**kwargs)
+                if formatters is None:  # llama-cpp-python's fallback format; no reuse, so still order-free
+                    llama.reset()
+                    _PIECES.pop(llama, None)
+                    self.last_reused_tokens = 0
+                    out = llama.create_chat_completion(messages=message_dicts(messages),
+                                                       stop=list(stop) if stop else None, **kwargs)
+                    text = out["choices"][0]["message"].get("content") or ""
+                else:
+                    dicts = message_dicts(messages)
+                    tokens, res = self._format(formatters[0], dicts)
+                    prompt = ChatPrompt(tokens, self._cuts(formatters[1], dicts, tokens))
+                    self._check_fits(prompt)
+                    # Evaluate up to the last cut here; generate() then finds exactly these tokens
+                    # in the context (its longest prefix match stops there) and evaluates the last piece in
+                    # one call, then one token per step.
+                    self._evaluate(prompt, upto=prompt.starts[-1] if prompt.starts else 0)
+                    out = llama.create_completion(prompt=list(prompt.tokens), stop=list(stop or []) + list(res.stop),
+                                                  stopping_criteria=res.stopping_criteria, **kwargs)
+                    _PIECES[llama] = prompt.ends
+                    text = out["choices"][0].get("text") or ""
             except ValueError as e:  # e.g. prompt longer than the context window
                 raise LMError(f"llamacpp {self.model}: {e} (n_ctx={self.n_ctx}; raise it with n_ctx=...)") from e
         latency = time.perf_counter() - t0
         usage = out.get("usage") or {}
-        text = out["choices"][0]["message"].get("content") or ""
         return Completion(text, Usage(prompt_tokens=int(usage.get("prompt_tokens", 0)),
                                       completion_tokens=int(usage.get("completion_tokens", 0)),
                                       latency_s=latency, cost_usd=0.0), model=self.identity())
@@ -280,41 +447,23 @@ class LlamaCppLM(LMBackend):
     # ------------------------------------------------------------------ log-probabilities
     def _prompt_tokens(self, messages: Sequence[Message]) -> list[int]:
         """Chat-formatted prompt with the assistant turn opened, as tokens."""
-        llama = self.llama
-        if self._formatter is None:
-            from llama_cpp.llama_chat_format import Jinja2ChatFormatter
+        return list(self.chat_prompt(messages).tokens)
 
-            template = llama.metadata.get("tokenizer.chat_template")
-            if not template:
-                raise LMError(f"llamacpp {self.model}: the GGUF has no chat template; choice_probabilities "
-                              f"needs one")
-            eos, bos = llama.token_eos(), llama.token_bos()
-            text_of = llama._model.token_get_text  # noqa: SLF001 - same helper Llama uses for its templates
-            self._formatter = Jinja2ChatFormatter(template=template, eos_token=text_of(eos) if eos != -1 else "",
-                                                  bos_token=text_of(bos) if bos != -1 else "",
-                                                  add_generation_prompt=True)
-        res = self._formatter(messages=message_dicts(messages))
-        return llama.tokenize(res.prompt.encode("utf-8"), add_bos=not res.added_special, special=True)
-
-    def next_token_logits(self, tokens: Sequence[int]) -> np.ndarray:
-        """Logits ``[vocab]`` of the token after ``tokens``, evaluating only the suffix not yet in the KV cache."""
+    def next_token_logits(self, prompt: ChatPrompt | Sequence[int]) -> np.ndarray:
+        """Logits ``[vocab]`` of the token after ``prompt``, evaluated by the schedule: KV entries up to a
+        shared cut are reused, the last piece is evaluated afresh. Bare token ids are one piece."""
+        if not isinstance(prompt, ChatPrompt):
+            prompt = ChatPrompt(prompt)
+        if not prompt.tokens:
+            raise LMError(f"llamacpp {self.model}: empty prompt")
+        self._check_fits(prompt)
         llama = self.llama
-        tokens = list(tokens)
-        if len(tokens) >= self.n_ctx:
-            raise LMError(f"llamacpp {self.model}: prompt of {len(tokens)} tokens does not fit n_ctx={self.n_ctx}")
-        prefix = 0
-        if self.reuse_prefix:
-            for a, b in zip(llama._input_ids.tolist(), tokens):  # noqa: SLF001
-                if a != b:
-                    break
-                prefix += 1
-        prefix = max(0, min(prefix, len(tokens) - 1))  # always decode at least one token to get fresh logits
-        self._set_threads(llama)
-        llama.n_tokens = prefix
-        llama.eval(tokens[prefix:])  # eval drops KV entries past n_tokens first
-        self.last_reused_tokens = prefix
-        logits = np.ctypeslib.as_array(llama._ctx.get_logits(), shape=(llama.n_vocab(),))  # noqa: SLF001
-        return np.array(logits, dtype=np.float64)
+        assert self._lock is not None
+        with self._lock:
+            self._set_threads(llama)
+            self._evaluate(prompt, upto=len(prompt.tokens))
+            logits = np.ctypeslib.as_array(llama._ctx.get_logits(), shape=(llama.n_vocab(),))  # noqa: SLF001
+            return np.array(logits, dtype=np.float64)
 
     def choice_probabilities(self, messages: Sequence[Message], choices: Sequence[str]) -> dict[str, float]:
         if not choices:
@@ -327,5 +476,5 @@ class LlamaCppLM(LMBackend):
 
         with self._lock:
             ids = first_token_ids(list(choices), tok)
-            logits = self.next_token_logits(self._prompt_tokens(messages))
+            logits = self.next_token_logits(self.chat_prompt(messages))
         return probabilities_from_logits(logits, ids)
