@@ -183,9 +183,9 @@ def category_messages(goal: str) -> tuple[Message, ...]:
 CATEGORY_EXAMPLES_WITH_OBJECTS: tuple[tuple[str, tuple[str, ...], tuple[str, ...], str], ...] = (
     ("put the aquarium supplies on the shelf", ("aquarium net", "fish food flakes"), ("tripod", "kettle"),
      "aquarium supplies"),
-    ("get the car cleaning things ready", ("car wax tin", "windshield squeegee"), ("toaster", "desk lamp"),
+    ("put the windshield squeegee in the trunk", ("car wax tin", "windshield squeegee"), ("toaster", "desk lamp"),
      "car cleaning things"),
-    ("keep the toddler away from anything with small parts", ("bag of marbles", "box of push pins"),
+    ("move around the bag of marbles", ("bag of marbles", "box of push pins"),
      ("beach ball", "floor cushion"), "things with small parts"),
     ("get ready for the party", ("party hat", "confetti cannon"), ("tire gauge", "bath mat"), "party supplies"),
 )
