@@ -304,7 +304,7 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
     def kernel(weighting):
         return GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
                                             probs=_probs_by_name(table)),
-                              weighting=weighting, language_kernel=TableKernel(vec))
+                              weighting=weighting, language_kernel=TableKernel(vec), calibration="none")
 
     k = kernel("reliability")
     rs = k.score(TEST, TRAIN, ART, rel)

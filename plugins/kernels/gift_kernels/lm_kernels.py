@@ -267,8 +267,10 @@ class GiftProbKernel(RelevanceKernel):
     from the goal and the training objects the demonstrations treat as part of it (one few-shot call per
     intent, plus one per training object with that object left out; :meth:`category`), then answers per
     object "is a <object> (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM description
-    similarity are z-scored and averaged, each weighted by how well it separates the relevant training
-    objects from the others (leave-one-out; ``weighting="reliability"``).
+    similarity go through one logistic calibration fitted on pooled development-suite intents and updated
+    with this intent's relevant training objects (``calibration="pooled"``), so 1/2 is the cut on every
+    intent. ``calibration="none"``: the terms are z-scored and averaged, each weighted by how well it
+    separates the relevant training objects from the others (leave-one-out; ``weighting="reliability"``).
 
     Options: ``template`` (a key of :data:`gift_kernels.prompts.RELEVANCE_TEMPLATES`), ``use_descriptions``,
     ``axes`` (also ask the intent's semantic-axis questions and keep the highest log-odds per object),
@@ -291,7 +293,7 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first", calibration: str = "none") -> None:
+                 select: str = "first", calibration: str | None = None) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -313,7 +315,11 @@ class GiftProbKernel(RelevanceKernel):
         self.select = select
         #: ``"none"``: z-scores per intent with reliability weights, the cut placed on the training scores;
         #: ``"pooled"``: the shipped :class:`~gift_kernels.calibration.TermCalibration`, updated per intent with
-        #: the relevant training objects (cut 1/2); or the path of a calibration file.
+        #: the relevant training objects (cut 1/2); or the path of a calibration file. Default: ``"pooled"``
+        #: with both terms (``combine="language"``), else ``"none"`` (chosen on gift-dev:
+        #: docs/results/front_half.md).
+        if calibration is None:
+            calibration = "pooled" if combine == "language" else "none"
         if calibration != "none" and combine != "language":
             raise GiftError("gift-prob: calibration needs both terms (combine='language')")
         if calibration == "none":
