@@ -5,8 +5,10 @@ so there the corrupted copy changes the results.
 
 Real components: the Drake plant simulates the human, the embedded model infers the intent and answers
 gift-prob's questions, MiniLM scores the language kernel. Reduced sizes (two training scenes of three
-demonstrations). The second run asks the LM nothing new: identical prompts are answered by the LM cache,
-which is itself evidence that no prompt changed.
+demonstrations). The simulated human does read the labels (they say what it demonstrates), so the
+demonstrations are made once from the true suite and saved; both inferred runs load them
+(``StudyConfig.demonstrations``), as a user's own demonstrations would be. The second run asks the LM
+nothing new: identical prompts are answered by the LM cache, which is itself evidence that no prompt changed.
 """
 
 from __future__ import annotations
@@ -47,18 +49,38 @@ def without(value, keys):
     return value
 
 
-def run(suite: Path, kernels: list[str], source: str, tmp_path: Path, tag: str) -> dict:
+def run(suite: Path, kernels: list[str], source: str, tmp_path: Path, tag: str, demos: Path | None = None) -> dict:
+    import attrs
+
     from gift.study.sweeps import evaluate_alignment
 
+    cfg = attrs.evolve(SIZES, demonstrations=str(demos) if demos else None)
     return evaluate_alignment(str(suite), kernels, intent_source=source, intents=[INTENT], executor="serial",
-                              config=SIZES, stages=tmp_path / f"stages-{tag}")
+                              config=cfg, stages=tmp_path / f"stages-{tag}")
+
+
+def saved_demonstrations(tmp_path: Path) -> Path:
+    """The training set of INTENT simulated from the true suite (Drake), saved as a user's demonstrations."""
+    import attrs
+
+    import gift
+    from gift.study.chain import get_training, intent_seeds
+    from gift.study.components import Components
+    from gift.study.scenes import save_training_set
+
+    suite = gift.load_suite(str(SUITE))
+    cfg = attrs.evolve(SIZES, suite=str(SUITE))
+    ts = get_training(Components(None, cfg.defaults), cfg, suite, suite.intent(INTENT),
+                      intent_seeds(cfg, INTENT)["train"])
+    save_training_set(tmp_path / "demos" / INTENT, ts)
+    return tmp_path / "demos"
 
 
 def test_inferred_mode_never_reads_the_suites_relevant_training_objects(tmp_path):
-    wrong = corrupted_copy(tmp_path)
+    wrong, demos = corrupted_copy(tmp_path), saved_demonstrations(tmp_path)
     kernels = ["gift-prob", "language"]
-    a = run(SUITE, kernels, "inferred", tmp_path, "a")
-    b = run(wrong, kernels, "inferred", tmp_path, "b")
+    a = run(SUITE, kernels, "inferred", tmp_path, "a", demos)
+    b = run(wrong, kernels, "inferred", tmp_path, "b", demos)
     for k in kernels:
         assert INTENT in a["kernels"][k]["intents"], a["kernels"][k].get("errors")
     rec = a["kernels"]["gift-prob"]["intents"][INTENT]
