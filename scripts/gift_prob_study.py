@@ -64,6 +64,7 @@ def load_rows(paths: Sequence[str]) -> list[dict[str, Any]]:
                          "intent": iid, "task": spec.task, "labels": np.array([t.relevant for t in spec.test]),
                          "rel": np.array([o in rel_names for o in spec.train_objects]),
                          "true_rel": np.array([o in spec.relevant_train for o in spec.train_objects]),
+                         "train_names": list(spec.train_objects),
                          "language_test": np.array(det["terms"]["language"]["test"]),
                          "language_train": np.array(det["terms"]["language"]["train"]),
                          "candidates": det["candidates"]})
@@ -78,6 +79,15 @@ def candidate(row: dict, rule: str) -> dict:
         return next(c for c in cands if c["chosen"])
     if rule == "objects":
         return next((c for c in cands if c["goal"] is None), cands[0])
+    if rule == "mean":  # every candidate's log-odds, z-scored over the intent's objects, averaged
+        zs = [_zscore(np.concatenate([c["lm_test"], c["lm_train"]])) for c in cands]
+        z, n = np.mean(zs, axis=0), len(cands[0]["lm_test"])
+        return {"goal": "mean", "category": " | ".join(c["category"] for c in cands), "lm_test": z[:n],
+                "lm_train": z[n:], "chosen": False}
+    if rule == "agree":  # the first goal that names no training object the demonstrations left alone
+        left = [o.lower() for o, r in zip(row["train_names"], row["rel"]) if not r]
+        ok = [c for c in cands if c["goal"] is None or not any(o in c["goal"].lower() for o in left)]
+        return ok[0] if ok else cands[-1]
     if rule == "best-test":
         return max(cands, key=lambda c: roc_auc(c["lm_test"], row["labels"]))
     raise ValueError(rule)
@@ -171,7 +181,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     fit_rows = load_rows(args.fit)
     report_rows = load_rows(args.report)
     out = []
-    for rule in ("text", "verified", "objects", "best-test"):
+    for rule in ("text", "verified", "objects", "mean", "agree", "best-test"):
         pooled, scale = pooled_fit(fit_rows, rule)
         for cut in ("loo", "oracle", "pooled", "pooled+intent"):
             for name, rows in (("fit", fit_rows), ("report", report_rows)):

@@ -590,13 +590,16 @@ def _slice(results: dict, errors: list[str], timing: dict, comp: Components, usa
 
 def _lm_usage(comp: Components) -> dict[str, Any] | None:
     """The public usage counters of ``comp``'s LM (None when it was not built or has no counters)."""
+    from gift.study.components import _public_counters
+
     if not comp.lm_built:
         return None
-    stats = getattr(comp.lm, "stats", None)
-    if stats is None:
-        return None
-    return {k: v for k, v in (attrs.asdict(stats, recurse=False) if attrs.has(type(stats))
-                              else vars(stats)).items() if not k.startswith("_")}
+    now = _public_counters(getattr(comp.lm, "stats", None))
+    base = getattr(comp, "lm_usage_baseline", None)
+    if now is None or not base:
+        return now
+    # counted since this study resolved the LM (a shared instance may carry earlier calls)
+    return {k: (add_usage(v, base[k], -1) if k in base else v) for k, v in now.items()}
 
 
 def add_usage(a: Any, b: Any, sign: int = 1) -> Any:

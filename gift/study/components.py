@@ -83,6 +83,16 @@ def check_spec(kind: str, spec: str) -> str | None:
     return None
 
 
+def _public_counters(stats: Any) -> dict[str, Any] | None:
+    """The public fields of an LM's usage counters (``stats``), or None."""
+    if stats is None:
+        return None
+    import attrs
+
+    fields = attrs.asdict(stats, recurse=False) if attrs.has(type(stats)) else vars(stats)
+    return {k: v for k, v in fields.items() if not k.startswith("_")}
+
+
 class Components:
     """The registered components one study uses, each built on first use and kept.
 
@@ -95,6 +105,7 @@ class Components:
         self.defaults = dict(defaults or {})
         self._built: dict[tuple[str, str], Any] = {}
         self._lm: Any = None
+        self.lm_usage_baseline: dict[str, Any] | None = None
         self._lock = threading.RLock()
 
     @property
@@ -104,7 +115,11 @@ class Components:
             if self._lm is None:
                 import gift
 
-                self._lm = gift.resolve_lm(self.lm_spec)
+                lm = gift.resolve_lm(self.lm_spec)
+                # a resolved LM may be a process-wide instance that counted calls before this study:
+                # usage is reported from here on (see gift.study.chain._lm_usage)
+                self.lm_usage_baseline = _public_counters(getattr(lm, "stats", None))
+                self._lm = lm
             return self._lm
 
     @property

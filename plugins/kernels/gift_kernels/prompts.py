@@ -27,7 +27,7 @@ per time step, feature values between 0 and 1. A feature named "a_proximity_to_b
 touch and 0.0 when they are far apart or one of them is missing.
 
 Find why the person preferred their version: the purpose, not the motion. Name the kind of objects that \
-matter (describe their category or property, e.g. "fragile items" rather than one object's name).
+matter: the category or property they share, not one object's name.
 
 Reply with one JSON object and nothing else:
 {"motivations": [{"text": "<one or two sentences>", "features": ["<feature name>", ...]}, ... three entries, \
