@@ -124,10 +124,10 @@ def write(result: dict, md: Path) -> None:
              "and count right); **win rate** is the RQ1 pairwise win rate of the re-scored alignment, mean over "
              f"the intents whose test scenes fit the table. `random` is the mean over {result['random_seeds']} "
              "seeds (± 1 standard error over seeds in the tables and the figure).", "",
-             "!!! note \"A first version\"",
-             "    These numbers were made with `gift-prob` as it stood at the commit below, while its recipe was "
-             "still changing (issue 16). The lead regenerates this page with the final recipe (same command; "
-             "finished kernel stages and LM answers are cached, so only what changed is recomputed).", "",
+             "!!! note \"Which recipe\"",
+             "    `gift-prob` with its default recipe at the commit below, the one measured in "
+             "[the front half](front_half.md). Inferred intents: the relevant training objects and the intent "
+             "come from the demonstrations alone.", "",
              "Command:", "", "```", result["command"], "```", "",
              f"Commit `{(git.get('commit') or '?')[:10]}`{' (dirty)' if git.get('dirty') else ''}, code version "
              f"`{result.get('code_version', '?')[:12]}`, LM `{lm.get('identity', '–')}` (model sha256 "
