@@ -8,6 +8,7 @@ import re
 import shutil
 from pathlib import Path
 
+import attrs
 import numpy as np
 import pytest
 
@@ -126,3 +127,111 @@ def test_undefined_numbers_of_strict_json_show_as_missing(tmp_path):
     page = write_html_report(results, tmp_path, render=False).read_text()
     assert 'class="section-error"' not in page and "–" in page
     assert 'data-plot="win-rate"' in page
+
+
+MINI = ROOT / "tests" / "kernels" / "data" / "mini_suite.yaml"
+
+
+def results_with_queries() -> dict:
+    """A study of one intent of the mini suite whose ``language`` row asked the simulated human 2 questions
+    (:func:`gift.study.chain.query_stage` on fixed kernel scores; no kernel, no LM, no Drake)."""
+    from gift.core.alignment import score_alignment
+    from gift.core.data import RelevanceScores
+    from gift.core.interfaces import RelevanceKernel
+    from gift.core.serialization import to_jsonable
+    from gift.study.chain import StudyConfig, query_label, query_stage
+
+    class Fixed(RelevanceKernel):
+        name = "fixed"
+
+        def score(self, test, train, intent=None, relevant_train=()):
+            return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
+                                   [0.8 if o.name in relevant_train else 0.2 for o in train],
+                                   [o.name in relevant_train for o in train])
+
+    suite = gift.load_suite(str(MINI))
+    spec = suite.intent("valuables")
+    scores = score_alignment(Fixed(), suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                             relevant_train=spec.relevant_train)
+    cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
+                      thresholds=("train-calibrated",))
+    q = query_stage(cfg, spec, scores)
+    row = query_label("language", cfg)
+    q0 = query_stage(attrs.evolve(cfg, queries=0), spec, scores)  # the kernel's own alignment
+    before = {k: q0[k] for k in ("cut", "note", "mapping", "scores", "metrics")}
+    results = {"config": {"suite": str(MINI), "robot": "franka", "kernels": ["language"], "queries": 2,
+                          "query_policy": "uncertainty", "thresholds": ["train-calibrated"]},
+               "alignment": {"valuables": {"language": {"thresholds": {"train-calibrated": before},
+                                                         "scores": scores.to_dict(), "queries": q}}},
+               "rq2": {"valuables": {"language": {"train-calibrated": q0["metrics"]["train-calibrated"]},
+                                     row: {"train-calibrated": q["metrics"]["train-calibrated"]}}},
+               "rq1": {"valuables": {"language": {"mean": 0.61, "se": 0.02, "per_seed": [0.6, 0.62]},
+                                     row: {"mean": 0.7, "se": 0.01, "per_seed": [0.69, 0.71]},
+                                     "oracle-labels": {"mean": 0.8, "se": 0.0, "per_seed": [0.8, 0.8]}}}}
+    return to_jsonable(results, nonfinite="null")
+
+
+def test_questions_asked_section_shows_policy_answers_and_before_after_plots(tmp_path):
+    results = results_with_queries()
+    q = results["alignment"]["valuables"]["language"]["queries"]
+    row = "language +2q uncertainty"
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert 'class="section-error"' not in page
+    assert _sections(page)[:3] == ["run", "headline", "queries"]
+    section = page.split('<section id="queries">', 1)[1].split("</section>", 1)[0]
+    assert "<h2>Questions asked</h2>" in section and f"<code>{row}</code>" in section and "uncertainty" in section
+    f1_before = results["rq2"]["valuables"]["language"]["train-calibrated"]["all"]["f1"]
+    f1_after = q["metrics"]["train-calibrated"]["all"]["f1"]
+    assert f"{f1_before:.3f} → <b>{f1_after:.3f}</b>" in section and "0.610 → <b>0.700</b>" in section
+    assert section.count('class="query-row"') == 1 and q["asked"] == 2
+    for a in q["answers"]:  # the objects asked, in order, with the simulated human's answer
+        word = "yes, relevant" if a["relevant"] else "no, not relevant"
+        assert f'<li data-object="{a["object"]}"><b>{a["object"]}</b>: {word}' in section
+    assert 'data-plot="queries-f1"' in section and 'data-plot="queries-win"' in section
+    assert f"valuables / {row}: F1 {f1_after:.3f} (train-calibrated threshold), after 2 question(s): " in section
+    assert "<title>valuables / language: win rate 0.610 ± 0.020, before the questions</title>" in section
+    assert 'data-plot="query-curve' not in section  # no curves file
+    assert not re.search(r'(src|href)="https?:', page)
+
+
+def test_no_questions_no_section(tmp_path):
+    results = results_with_queries()
+    del results["alignment"]["valuables"]["language"]["queries"]
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert "queries" not in _sections(page) and "Questions asked" not in page
+    assert 'class="section-error"' not in page
+
+
+CURVES = {"command": "python scripts/query_curves.py --suites mini",
+          "runs": {"mini | ground-truth": {
+              "grid": [0, 1, 2],
+              "curves": {"uncertainty": {"f1": [0.5, 0.7, 0.9], "win": [0.6, 0.65, 0.7], "asked": [0, 1, 2]},
+                         "random": {"f1": [0.5, 0.55, 0.6], "f1_se": [0.0, 0.02, 0.03],
+                                    "win": [None, None, None], "asked": [0, 1, 2]}}}}}
+
+
+def test_query_curves_from_gift_report(tmp_path):
+    """``gift report OUT --query-curves FILE``: the curves per policy (random with its band) in the section,
+    kept in OUT for later regenerations; a run without questions gets the section for the curves alone."""
+    from gift.cli import main
+
+    results = results_with_queries()
+    del results["alignment"]["valuables"]["language"]["queries"]
+    (tmp_path / "results.json").write_text(json.dumps(results))
+    (tmp_path / "curves.json").write_text(json.dumps(CURVES))
+    assert main(["report", str(tmp_path), "--no-render", "--query-curves", str(tmp_path / "curves.json")]) == 0
+    page = (tmp_path / "report.html").read_text()
+    assert 'class="section-error"' not in page and "queries" in _sections(page)
+    section = page.split('<section id="queries">', 1)[1].split("</section>", 1)[0]
+    assert 'class="query-row"' not in section and "python scripts/query_curves.py --suites mini" in section
+    assert section.count('data-plot="query-curve-f1"') == 1 and section.count('data-plot="query-curve-win"') == 1
+    assert section.count('class="band"') == 1  # random's ± s.e. on F1; its win rate is undefined: no curve
+    assert ("<title>mini | ground-truth: random, 2 question(s) per intent: alignment F1 (pooled) 0.600 ± 0.030 "
+            "(s.e. over seeds)</title>") in section
+    assert section.count('class="curve"') == 3  # F1: uncertainty, random; win rate: uncertainty
+    # kept in the folder: regenerating without the option draws them again
+    assert main(["report", str(tmp_path), "--no-render"]) == 0
+    assert 'data-plot="query-curve-f1"' in (tmp_path / "report.html").read_text()
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"x": 1}')
+    assert main(["report", str(tmp_path), "--no-render", "--query-curves", str(bad)]) != 0

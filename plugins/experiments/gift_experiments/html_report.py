@@ -11,9 +11,12 @@ Built from ``results.json`` and the output folder alone, so ``gift report OUT`` 
 - ``views/index.json``: the Meshcat pages of :mod:`gift_experiments.views`;
 - ``renders/``: object thumbnails (JPEG, three views), made from the simulator's ``render_object`` the first
   time and read from there afterwards (so regenerating needs Drake only for objects not yet drawn);
-- the PNG figures of :func:`gift_experiments.report.make_figures`.
+- the PNG figures of :func:`gift_experiments.report.make_figures`;
+- ``query_curves.json``: optional query curves (the format of ``scripts/query_curves.py``,
+  :mod:`gift_experiments.query_curves`), copied there by ``gift report OUT --query-curves FILE``.
 
-Sections (``<section id=...>``): ``run``, ``headline``, one ``intent-<id>`` per intent (inferred intent and
+Sections (``<section id=...>``): ``run``, ``headline``, ``queries`` (only when the run asked the simulated
+human questions, ``gift reproduce --queries N``, or the folder has query curves), one ``intent-<id>`` per intent (inferred intent and
 its candidates, win rates, every test object with its renders, label and, per kernel, score, cut, decision
 and the training object it maps to; the similarity plots), ``views``, ``rq3``, ``sanity``, ``lm-calls``,
 ``failures``, ``timing``, ``figures``. A section whose data is missing says so; a section that fails to
@@ -37,12 +40,15 @@ import numpy as np
 from gift.core.data import DISTRACTOR
 from gift_experiments.lm_calls import LM_CALLS, LMCall, read_calls
 from gift_experiments.report import KERNEL_ORDER, SUBSET_LABEL
-from gift_experiments.svg_plots import Point, StripRow, bar_chart, esc, scatter, strips
+from gift_experiments.svg_plots import Line, Point, StripRow, bar_chart, esc, lines, scatter, strips
 from gift_experiments.views import load_alignments, main_threshold, relevant_training
 
 log = logging.getLogger(__name__)
 
 REPORT = "report.html"
+QUERY_CURVES = "query_curves.json"
+#: Colours of the query policies in the query curves (those of :func:`gift_experiments.query_curves.figure`).
+POLICY_COLOURS = {"uncertainty": "#1f77b4", "disagreement": "#ff7f0e", "error-bound": "#2ca02c", "random": "#7f7f7f"}
 ORACLE = "oracle-labels"
 THUMB_PX = 72
 #: At most this many LM calls are written into the page (the rest stay in lm_calls.jsonl).
@@ -138,7 +144,8 @@ class Report:
     """Builds the page from ``results`` and the output folder ``out`` (see the module docstring)."""
 
     def __init__(self, results: Mapping[str, Any], out: Path, *, command: str = "",
-                 lm_record: Path | None = None, render: bool = True, simulator=None) -> None:
+                 lm_record: Path | None = None, render: bool = True, simulator=None,
+                 query_curves: Mapping[str, Any] | None = None) -> None:
         self.r = results
         self.out = Path(out)
         self.command = command
@@ -148,6 +155,17 @@ class Report:
         self.suite = self._load_suite()
         self.thumbs = Thumbnails(self.out, self.cfg.get("robot", "franka"), render=render, simulator=simulator)
         self.views = self._load_views()
+        self.curves = query_curves if query_curves is not None else self._load_curves()
+
+    def _load_curves(self) -> Mapping[str, Any] | None:
+        path = self.out / QUERY_CURVES
+        if not path.is_file():
+            return None
+        try:
+            return json.loads(path.read_text())
+        except ValueError as e:
+            log.warning("unreadable %s: %s", path, e)
+            return None
 
     def _load_suite(self):
         name = self.cfg.get("suite")
@@ -456,6 +474,180 @@ class Report:
             return _missing("No similarity data for this intent.")
         return '<h3>Similarity plots</h3><div class="plots">' + "".join(out) + "</div>"
 
+    # ------------------------------------------------------------------ questions asked
+    def query_rows(self) -> list[tuple[str, str, str, Mapping[str, Any], Mapping[str, Any]]]:
+        """``[(intent, kernel, row, alignment record, queries record)]``: each kernel the run asked the simulated
+        human about (``alignment[intent][kernel]["queries"]``, :func:`gift.study.chain.query_stage`); ``row``:
+        its row in RQ1/RQ2 (:func:`gift.study.chain.query_label`)."""
+        out = []
+        for intent, per in (self.r.get("alignment") or {}).items():
+            for kernel, rec in (per.items() if isinstance(per, Mapping) else ()):
+                q = rec.get("queries") if isinstance(rec, Mapping) else None
+                if isinstance(q, Mapping):
+                    out.append((intent, kernel, self._query_row(intent, kernel, q), rec, q))
+        return out
+
+    def _query_row(self, intent: str, kernel: str, q: Mapping[str, Any]) -> str:
+        from types import SimpleNamespace
+
+        from gift.study.chain import query_label
+
+        label = query_label(kernel, SimpleNamespace(queries=q.get("queries") or 0, query_policy=q.get("policy", ""),
+                                                    abstain=q.get("abstain") or 0.0))
+        rows = {**((self.r.get("rq2") or {}).get(intent) or {}), **((self.r.get("rq1") or {}).get(intent) or {})}
+        if label not in rows:  # a label format of another version: the row that extends the kernel's name
+            label = next((k for k in rows if k.startswith(kernel + " ") and k not in self.cfg.get("kernels", [])),
+                         label)
+        return label
+
+    def _before_after(self, intent: str, kernel: str, row: str, q: Mapping[str, Any]) -> dict[str, Any]:
+        """F1 (at the threshold the answers moved) and RQ1 win rate of ``kernel`` before and of ``row`` after."""
+        th = q.get("threshold")
+        rq1 = (self.r.get("rq1") or {}).get(intent) or {}
+        rq2 = (self.r.get("rq2") or {}).get(intent) or {}
+
+        def f1(block):
+            return (((block or {}).get(th) or {}).get("all") or {}).get("f1")
+
+        after = f1(rq2.get(row)) if row in rq2 else f1(q.get("metrics"))
+        return {"f1": (f1(rq2.get(kernel)), after),
+                "win": ((rq1.get(kernel) or {}).get("mean"), (rq1.get(row) or {}).get("mean")),
+                "se": ((rq1.get(kernel) or {}).get("se"), (rq1.get(row) or {}).get("se"))}
+
+    @staticmethod
+    def _answers_text(q: Mapping[str, Any]) -> str:
+        return ", ".join(f"{a['object']} ({_answer_word(a)})" for a in q.get("answers") or []) or "none"
+
+    def queries(self) -> str:
+        rows = self.query_rows()
+        parts = []
+        if rows:
+            parts += [self._query_summary(rows), self._query_plots(rows), self._query_answers(rows)]
+        if self.curves:
+            parts.append(self._query_curves())
+        return "".join(parts)
+
+    def _query_summary(self, rows) -> str:
+        by_row: dict[str, list] = {}
+        for intent, kernel, row, _, q in rows:
+            by_row.setdefault(row, []).append((intent, kernel, q))
+        out = []
+        for row, items in by_row.items():
+            kernel, q0 = items[0][1], items[0][2]
+            ba = [self._before_after(i, k, row, q) for i, k, q in items]
+
+            def mean(key, j):
+                v = _finite(b[key][j] for b in ba)
+                return float(np.mean(v)) if v else None
+
+            asked = [int(q.get("asked", len(q.get("answers") or []))) for _, _, q in items]
+            flagged = sum(int(q.get("n_abstained") or 0) for _, _, q in items)
+            out.append([f'<span class="swatch" style="background:{_colour(kernel)}"></span>{esc(kernel)}',
+                        f"<code>{esc(row)}</code>", esc(q0.get("policy", "–")),
+                        f"{q0.get('queries', '–')} (asked {_num(float(np.mean(asked)), 1)} on average)",
+                        esc(q0.get("threshold", "–")),
+                        f"{_num(mean('f1', 0))} → <b>{_num(mean('f1', 1))}</b>",
+                        f"{_num(mean('win', 0))} → <b>{_num(mean('win', 1))}</b>",
+                        f"{flagged} (band {_num(q0.get('abstain') or 0.0, 2)})" if q0.get("abstain") else "–"])
+        note = (f"<p>{len({r[0] for r in rows})} intent(s). The simulated human (the suite's labels) answered up to "
+                "the given number of questions per intent and kernel, chosen by the policy; the answers re-score the "
+                "kernel's alignment (no kernel runs again) and move the cut of the threshold shown. Before → after: "
+                "mean over intents of the F1 on every test object and of the RQ1 win rate.</p>")
+        return note + _table(["kernel", "row after the answers", "policy", "questions per intent", "threshold",
+                              "F1 before → after", "win rate before → after", "abstained"], out, "queries")
+
+    def _query_plots(self, rows) -> str:
+        intents = list(dict.fromkeys(r[0] for r in rows))
+        pairs = list(dict.fromkeys((r[1], r[2]) for r in rows))  # (kernel, row)
+        series = [name for pair in pairs for name in pair]
+        cell = {(i, row): (k, q) for i, k, row, _, q in rows}
+        plots = []
+        for key, what, ylabel, ref in (("f1", "F1", "alignment F1", None), ("win", "win rate", "pairwise win rate",
+                                                                              0.5)):
+            mean = np.full((len(series), len(intents)), np.nan)
+            se = np.full_like(mean, np.nan)
+            tips = [[""] * len(intents) for _ in series]
+            for g, intent in enumerate(intents):
+                for p, (kernel, row) in enumerate(pairs):
+                    if (intent, row) not in cell:
+                        continue
+                    q = cell[(intent, row)][1]
+                    ba = self._before_after(intent, kernel, row, q)
+                    for j, when in enumerate(("before the questions", f"after {q.get('asked', 0)} question(s): "
+                                                                      f"{self._answers_text(q)}")):
+                        s = 2 * p + j
+                        v, e = ba[key][j], ba["se"][j] if key == "win" else None
+                        mean[s, g] = v if v is not None else np.nan
+                        se[s, g] = e if e is not None else np.nan
+                        tips[s][g] = (f"{intent} / {series[s]}: {what} {_num(v)}" + (f" ± {_num(e)}" if e is not None
+                                                                                      else "") +
+                                      (f" ({q.get('threshold')} threshold)" if key == "f1" else "") + f", {when}")
+            if np.isfinite(mean).any():
+                plots.append(bar_chart(intents, series, mean, se, tips=tips, ylabel=ylabel, ref=ref,
+                                       title=f"{what} per intent before and after the questions",
+                                       kind=f"queries-{key}"))
+        return '<div class="plots">' + "".join(plots) + "</div>" if plots else ""
+
+    def _query_answers(self, rows) -> str:
+        out = []
+        for intent, kernel, row, rec, q in rows:
+            th = q.get("threshold")
+            before = (((rec.get("thresholds") or {}).get(th)) or {}).get("mapping") or {}
+            after = q.get("mapping") or {}
+            items = []
+            for a in q.get("answers") or []:
+                o = a["object"]
+                was, now = before.get(o), after.get(o)
+                moved = (f" <small>({'→ ' + esc(was) if was not in (None, DISTRACTOR) else 'distractor'} before, "
+                         f"{'→ ' + esc(now) if now not in (None, DISTRACTOR) else 'distractor'} after)</small>"
+                         if was is not None or now is not None else "")
+                items.append(f'<li data-object="{esc(o)}"><b>{esc(o)}</b>: {esc(_answer_word(a))}{moved}</li>')
+            asked = f"<ol>{''.join(items)}</ol>" if items else '<span class="missing">no question asked</span>'
+            ab = q.get("abstained") or []
+            ba = self._before_after(intent, kernel, row, q)
+            out.append(f'<tr class="query-row" data-intent="{esc(intent)}" data-kernel="{esc(kernel)}">'
+                       + "".join(f"<td>{c}</td>" for c in [
+                           esc(intent), f"<code>{esc(row)}</code>", asked,
+                           f"{_num(q.get('cut'))} <small>{esc(q.get('note', ''))}</small>",
+                           esc(", ".join(ab)) if ab else "–", _num(q.get("error_bound")),
+                           f"{_num(ba['f1'][0])} → <b>{_num(ba['f1'][1])}</b>",
+                           f"{_num(ba['win'][0])} → <b>{_num(ba['win'][1])}</b>"]) + "</tr>")
+        head = "".join(f"<th>{c}</th>" for c in ["intent", "row", "questions (in the order asked) and answers",
+                                                  "cut after (how placed)", "abstained", "error bound", "F1",
+                                                  "win rate"])
+        return (f'<h3>Questions and answers per intent</h3><table class="query-answers"><thead><tr>{head}</tr>'
+                f"</thead><tbody>{''.join(out)}</tbody></table>")
+
+    def _query_curves(self) -> str:
+        runs = self.curves.get("runs") if "runs" in self.curves else {"": self.curves}
+        out = []
+        for name, sim in (runs or {}).items():
+            grid, curves = sim.get("grid") or [], sim.get("curves") or {}
+            if not grid or not curves:
+                continue
+            for key, what in (("f1", "alignment F1 (pooled)"), ("win", "win rate (mean over intents)")):
+                ls = []
+                for policy, c in curves.items():
+                    ys = tuple(c.get(key) or ())
+                    if not any(v is not None for v in ys):
+                        continue
+                    band = tuple(c[key + "_se"]) if c.get(key + "_se") else None
+                    tips = tuple(f"{name + ': ' if name else ''}{policy}, {k} question(s) per intent: {what} "
+                                 f"{_num(v)}" + (f" ± {_num(band[j])} (s.e. over seeds)" if band else "")
+                                 for j, (k, v) in enumerate(zip(grid, ys)))
+                    ls.append(Line(policy, ys, band, tips, dashed=policy == "random",
+                                   colour=POLICY_COLOURS.get(policy, "")))
+                if ls:
+                    out.append(lines(grid, ls, xlabel="questions per intent", ylabel=what.split(" (")[0],
+                                     title=f"{name}: {what}" if name else what, kind=f"query-curve-{key}"))
+        if not out:
+            return _missing("The query curves file has no curves.")
+        cmd = self.curves.get("command")
+        src = f" (<code>{esc(cmd)}</code>)" if cmd else ""
+        return (f"<h3>Query curves</h3><p>From <code>{QUERY_CURVES}</code>{src}: each policy asks k questions "
+                "per intent, answered from the suite's labels; random is the mean over seeds, shaded ± s.e.</p>"
+                f'<div class="plots">{"".join(out)}</div>')
+
     # ------------------------------------------------------------------ views, rq3, sanity
     def views_section(self) -> str:
         if not self.views:
@@ -558,6 +750,8 @@ class Report:
     def html(self) -> str:
         sections: list[tuple[str, str, Callable[[], str]]] = [
             ("run", "Run", self.run), ("headline", "Headline", self.headline)]
+        if self.query_rows() or self.curves:
+            sections.append(("queries", "Questions asked", self.queries))
         for i in self.intents():
             sections.append((f"intent-{i}", f"Intent {i}", lambda i=i: self.intent(i)))
         sections += [("views", "Replays (Meshcat)", self.views_section),
@@ -587,6 +781,12 @@ def _colour(kernel: str) -> str:
     from gift_experiments.svg_plots import colour
 
     return colour(kernel)
+
+
+def _answer_word(a: Mapping[str, Any]) -> str:
+    """An answer of the simulated human in words: relevant, not relevant or don't know, and what it plays."""
+    word = {True: "yes, relevant", False: "no, not relevant"}.get(a.get("relevant"), "don't know")
+    return word + (f", plays {a['plays']}" if a.get("plays") else "")
 
 
 def _lm_call(c: LMCall) -> str:
@@ -656,13 +856,15 @@ SCRIPT = """
 
 
 def write_html_report(results: Mapping[str, Any], out_dir: Path, *, command: str = "", lm_record: Path | None = None,
-                      render: bool = True, simulator=None) -> Path:
+                      render: bool = True, simulator=None, query_curves: Mapping[str, Any] | None = None) -> Path:
     """Write ``out_dir/report.html`` from ``results`` and what the output folder holds (see the module
     docstring). ``lm_record``: the LM call record (default ``out_dir/lm_calls.jsonl``); ``render=False``:
-    use only thumbnails already in ``out_dir/renders`` (no Drake). Returns the path."""
+    use only thumbnails already in ``out_dir/renders`` (no Drake); ``query_curves``: the query curves to draw
+    (default: ``out_dir/query_curves.json`` when it is there). Returns the path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    page = Report(results, out, command=command, lm_record=lm_record, render=render, simulator=simulator).html()
+    page = Report(results, out, command=command, lm_record=lm_record, render=render, simulator=simulator,
+                  query_curves=query_curves).html()
     path = out / REPORT
     tmp = path.with_suffix(".tmp")
     tmp.write_text(page, encoding="utf-8")
@@ -670,13 +872,27 @@ def write_html_report(results: Mapping[str, Any], out_dir: Path, *, command: str
     return path
 
 
-def regenerate(out_dir: Path, *, render: bool = True) -> Path:
-    """``report.html`` again from ``out_dir/results.json`` (``gift report OUT``)."""
+def regenerate(out_dir: Path, *, render: bool = True, query_curves: Path | None = None) -> Path:
+    """``report.html`` again from ``out_dir/results.json`` (``gift report OUT``); ``query_curves``: a query
+    curves JSON (``docs/results/queries/curves.json``), copied to ``out_dir/query_curves.json`` so that later
+    regenerations draw it too."""
+    from gift.core.errors import GiftError
+
     path = Path(out_dir) / "results.json"
     if not path.is_file():
-        from gift.core.errors import GiftError
-
         raise GiftError(f"no results.json in {out_dir}: give the output folder of gift demo or gift reproduce")
+    if query_curves is not None:
+        try:
+            curves = json.loads(Path(query_curves).read_text())
+        except (OSError, ValueError) as e:
+            raise GiftError(f"cannot read the query curves {query_curves}: {e}") from e
+        if not isinstance(curves, Mapping) or not ("runs" in curves or "curves" in curves):
+            raise GiftError(f"{query_curves} is not a query curves file (no 'runs' or 'curves'): give the JSON "
+                            "written by scripts/query_curves.py")
+        dest = Path(out_dir) / QUERY_CURVES
+        if Path(query_curves).resolve() != dest.resolve():
+            dest.write_text(json.dumps(curves, indent=1), encoding="utf-8")
+            log.info("query curves copied to %s", dest)
     results = json.loads(path.read_text())
     command = ""
     md = Path(out_dir) / "report.md"

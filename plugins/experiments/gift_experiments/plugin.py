@@ -208,6 +208,9 @@ def _configure_report(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-render", action="store_true",
                    help="use only the object thumbnails already in OUT/renders (no Drake)")
     p.add_argument("--views", action="store_true", help="also (re)write the Meshcat replays in OUT/views")
+    p.add_argument("--query-curves", default=None, metavar="FILE",
+                   help="query curves JSON of scripts/query_curves.py (docs/results/queries/curves.json) to draw in "
+                        "the 'Questions asked' section; copied to OUT/query_curves.json for later regenerations")
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -222,7 +225,8 @@ def run_report(args: argparse.Namespace) -> int:
             raise GiftError(f"no results.json in {out}: give the output folder of gift demo or gift reproduce")
         for e in export_views(json.loads(path.read_text()), out):
             print(f"{e['intent']}/{e['view']}: {e.get('file') or e.get('error')}")
-    print(f"report.html: {regenerate(out, render=not args.no_render)}")
+    curves = Path(args.query_curves) if args.query_curves else None
+    print(f"report.html: {regenerate(out, render=not args.no_render, query_curves=curves)}")
     return 0
 
 

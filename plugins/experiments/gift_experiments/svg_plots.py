@@ -212,3 +212,65 @@ def strips(rows: Sequence[StripRow], *, xlabel: str = "decision score", title: s
                         f'cx="{f.x(p.x):.1f}" cy="{yc + j:.1f}" r="4.5" '
                         f'fill="{RELEVANT if p.relevant else OTHER}">{title_el}</circle>')
     return _svg(kind, 560, height, body, title)
+
+
+@attrs.frozen
+class Line:
+    """One curve of :func:`lines`: ``y`` per x (None: no point), an optional ± ``band``, and hover texts."""
+
+    name: str
+    y: tuple[float | None, ...]
+    band: tuple[float | None, ...] | None = None
+    tips: tuple[str, ...] = ()
+    dashed: bool = False
+    colour: str = ""
+
+
+def lines(x: Sequence[float], curves: Sequence[Line], *, xlabel: str = "", ylabel: str = "", title: str = "",
+          ylim: tuple[float, float] | None = None, kind: str = "lines") -> str:
+    """A line with a dot per x for each curve (its ± band shaded, a dot's hover text from ``tips``); ``ylim``:
+    the data range, padded, when None."""
+    ys = []
+    for c in curves:
+        for j, v in enumerate(c.y):
+            if v is not None:
+                b = (c.band[j] if c.band else None) or 0.0
+                ys += [v - b, v + b]
+    if ylim is None:
+        lo, hi = (min(ys), max(ys)) if ys else (0.0, 1.0)
+        pad = 0.08 * max(hi - lo, 0.05)
+        ylim = (lo - pad, hi + pad)
+    legend_w = 16 + 6.5 * max((len(c.name) for c in curves), default=0)
+    width = int(340 + legend_w)
+    xs = [float(v) for v in x]
+    f = _Frame(width, 250, 56, int(legend_w) + 14, 24 if title else 10, 38,
+               (min(xs), max(xs)) if len(xs) > 1 and max(xs) > min(xs) else (0.0, 1.0), ylim)
+    body = f.axes(xlabel, ylabel, xticks=False)
+    y0 = f.height - f.bottom
+    for v in xs:
+        body.append(f'<line x1="{f.x(v):.1f}" x2="{f.x(v):.1f}" y1="{y0}" y2="{y0 + 4}" class="axis"/>'
+                    f'<text x="{f.x(v):.1f}" y="{y0 + 16}" class="tick" text-anchor="middle">{v:g}</text>')
+    for i, c in enumerate(curves):
+        col = c.colour or colour(c.name, i)
+        pts = [(f.x(a), v, b) for a, v, b in zip(xs, c.y, c.band or (None,) * len(c.y)) if v is not None]
+        if c.band and any(b for _, _, b in pts):
+            upper = [f"{px:.1f},{f.y(min(v + (b or 0), ylim[1])):.1f}" for px, v, b in pts]
+            lower = [f"{px:.1f},{f.y(max(v - (b or 0), ylim[0])):.1f}" for px, v, b in reversed(pts)]
+            body.append(f'<polygon class="band" data-series="{esc(c.name)}" points="{" ".join(upper + lower)}" '
+                        f'fill="{col}" fill-opacity="0.18" stroke="none"/>')
+        if len(pts) > 1:
+            path = " ".join(f"{px:.1f},{f.y(v):.1f}" for px, v, _ in pts)
+            dash = ' stroke-dasharray="5 3"' if c.dashed else ""
+            body.append(f'<polyline class="curve" data-series="{esc(c.name)}" points="{path}" fill="none" '
+                        f'stroke="{col}" stroke-width="2"{dash}/>')
+        for j, (a, v) in enumerate(zip(xs, c.y)):
+            if v is None:
+                continue
+            b = c.band[j] if c.band else None
+            attr, title_el = _tip(c.tips[j] if j < len(c.tips) else
+                                  f"{c.name}: {v:.3f}" + (f" ± {b:.3f}" if b else "") + f" at {a:g}")
+            body.append(f'<circle class="pt" data-series="{esc(c.name)}"{attr} cx="{f.x(a):.1f}" cy="{f.y(v):.1f}" '
+                        f'r="4" fill="{col}">{title_el}</circle>')
+    body.append(_legend([c.name for c in curves], f.width - f.right + 10, f.top + 4,
+                        [c.colour or colour(c.name, i) for i, c in enumerate(curves)]))
+    return _svg(kind, width, 250, body, title)
