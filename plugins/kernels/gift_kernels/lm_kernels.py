@@ -294,7 +294,7 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first", calibration: str | None = None) -> None:
+                 select: str = "first", calibration: str = "none") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -320,8 +320,6 @@ class GiftProbKernel(RelevanceKernel):
         #: pooled calibration, fitted on gift-dev with the true intents, lifted train-calibrated F1 there
         #: (0.78 -> 0.84) but collapsed with inferred intents (0.65 -> 0.35: their categories put the LM
         #: log-odds on another scale); docs/results/front_half.md.
-        if calibration is None:
-            calibration = "none"
         if calibration != "none" and combine != "language":
             raise GiftError("gift-prob: calibration needs both terms (combine='language')")
         if calibration == "none":
