@@ -54,10 +54,11 @@ def table(path: str, extra: Sequence[str] = ()) -> str:
                    if iid in kernels[b]["intents"])
         wins += f1 > best[0]
         text = rec["intent_text"] if inferred else "(true)"
-        lines.append(f"| `{iid}` | {', '.join(used)}{ok} | {text} | "
-                     f"{cos[iid]:.2f} | " if inferred else f"| `{iid}` | {', '.join(used)}{ok} | {text} | – | ")
-        lines[-1] += (f"{(rec.get('details') or {}).get('category', '')} | {f1:.2f} ({rec['metrics'][OR]['all']['f1']:.2f})"
-                      f" | {rec['metrics'][TC]['all']['auc']:.2f} | {best[0]:.2f} ({best[1]}) |")
+        cosine = f"{cos[iid]:.2f}" if inferred else "–"
+        category = (rec.get("details") or {}).get("category", "")
+        lines.append(f"| `{iid}` | {', '.join(used)}{ok} | {text} | {cosine} | {category} | "
+                     f"{f1:.2f} ({rec['metrics'][OR]['all']['f1']:.2f}) | {rec['metrics'][TC]['all']['auc']:.2f} | "
+                     f"{best[0]:.2f} ({best[1]}) |")
     lines += ["", f"gift-prob above the best baseline on {wins} of {len(kernels[gp]['intents'])} intents"
               + (f"; mean cosine to the true text {np.mean(list(cos.values())):.2f}" if cos else "") + ".", "",
               "| kernel | F1 train-calibrated | F1 oracle cut | AUC (mean over intents) |", "|---|---|---|---|"]
