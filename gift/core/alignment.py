@@ -43,7 +43,10 @@ Thresholds (``threshold=``)
   pass. A relevant object with no relevant partner left is not a usable positive. With no positive or
   no negative left it falls back to ``non-oracle`` and says so in the note. A relevance kernel whose
   scores are calibrated probabilities with the training evidence already folded in
-  (``RelevanceScores.cut``, e.g. gift-prob with ``calibration="pooled"``) gives the cut itself: 1/2.
+  (``RelevanceScores.cut``, e.g. gift-prob with ``calibration="pooled"``) gives the cut itself: 1/2. A
+  relevance kernel whose scale has a boundary of its own (``RelevanceScores.prior_cut``, e.g. gift-prob's
+  1/2 at the scene's mean) has the leave-one-out cut averaged with it, ``w * prior + (1 - w) * loo``
+  (``prior_weight``): a few training objects place a cut noisily (docs/results/front_half.md).
 - ``"oracle"``: the cut that maximises F1 on the labelled test objects (``test_labels``): an upper bound.
 
 f_ω on trajectories
@@ -253,6 +256,9 @@ class AlignmentScores:
     details: Mapping[str, Any] = attrs.field(factory=dict, eq=False)
     #: the cut a calibrated relevance kernel's probabilities call for (train-calibrated uses it), or None
     natural_cut: float | None = None
+    #: a relevance kernel's prior cut and its weight in the train-calibrated cut (RelevanceScores.prior_cut)
+    prior_cut: float | None = None
+    prior_weight: float = 0.5
     relevant_mask: np.ndarray | None = attrs.field(default=None, eq=False)
     #: True when the scores come from a RelevanceKernel (K = relevance in the relevant columns)
     relevance_kernel: bool = False
@@ -266,7 +272,8 @@ class AlignmentScores:
                                "relevant_train": list(self.relevant_train), "kernel": self.kernel,
                                "train_mean": self.train_mean, "fallbacks": list(self.fallbacks),
                                "details": dict(self.details), "relevance_kernel": self.relevance_kernel,
-                               "natural_cut": self.natural_cut}
+                               "natural_cut": self.natural_cut, "prior_cut": self.prior_cut,
+                               "prior_weight": self.prior_weight}
         for name in self._ARRAYS:
             v = getattr(self, name)
             out[name] = None if v is None else np.asarray(v).tolist()
@@ -286,14 +293,16 @@ class AlignmentScores:
         return cls(test=tuple(d["test"]), train=tuple(d["train"]), relevant_train=tuple(d.get("relevant_train", ())),
                    kernel=d.get("kernel", ""), train_mean=d.get("train_mean"), fallbacks=tuple(d.get("fallbacks", ())),
                    details=dict(d.get("details") or {}), relevance_kernel=bool(d.get("relevance_kernel", False)),
-                   natural_cut=d.get("natural_cut"), **arrays)
+                   natural_cut=d.get("natural_cut"), prior_cut=d.get("prior_cut"),
+                   prior_weight=float(d.get("prior_weight", 0.5)), **arrays)
 
     def with_relevance(self, relevance: Sequence[float], train_loo: Sequence[float]) -> "AlignmentScores":
         """The same scene scored by other relevances (a term of the kernel, another intent candidate):
         ``relevance`` ``[n_test]`` and ``train_loo`` ``[n_train]`` in [0, 1], with the relevant columns,
         the targets' rule and the thresholds' evidence rebuilt as :func:`score_alignment` builds them.
         Only for the scores of a relevance kernel; a view has no natural cut (its scores are not the kernel's
-        calibrated probabilities), so its train-calibrated cut is placed on its training scores."""
+        calibrated probabilities), so its train-calibrated cut is placed on its training scores; it keeps the
+        kernel's prior cut (views are on the kernel's relevance scale)."""
         if not self.relevance_kernel or self.relevant_mask is None:
             raise GiftError(f"with_relevance needs the scores of a relevance kernel; {self.kernel!r} gave a matrix")
         r = _check_vector(relevance, len(self.test), self.kernel, "the test objects (view)")
@@ -301,7 +310,7 @@ class AlignmentScores:
         return _relevance_scores(self.test, self.train, self.relevant_train, self.kernel, r, t, self.relevant_mask,
                                  want_train=self.train_mean is not None,
                                  calibrated=self.loo_scores is not None, details=self.details,
-                                 fallbacks=self.fallbacks)
+                                 fallbacks=self.fallbacks, prior=(self.prior_cut, self.prior_weight))
 
     def threshold(self, strategy: str | float, test_labels: Mapping[str, bool] | None = None
                   ) -> tuple[float, str]:
@@ -344,8 +353,13 @@ class AlignmentScores:
                                     "negative leave-one-out score, and no K(train, train) mean to fall back on")
                 return self.train_mean, (f"fallback to non-oracle: leave-one-out gave {pos.size} positive and "
                                          f"{neg.size} negative scores")
-            return float(np.clip(best_separating_cut(pos, neg), 0.0, 1.0)), \
-                f"leave-one-out over {pos.size} relevant / {neg.size} other training objects"
+            cut = float(np.clip(best_separating_cut(pos, neg), 0.0, 1.0))
+            note = f"leave-one-out over {pos.size} relevant / {neg.size} other training objects"
+            if self.prior_cut is None or self.prior_weight == 0.0:
+                return cut, note
+            w = self.prior_weight
+            return (w * self.prior_cut + (1.0 - w) * cut,
+                    f"{note} ({cut:.3f}), averaged with the kernel's prior cut {self.prior_cut:g} (weight {w:g})")
         raise GiftError(f"unknown threshold {strategy!r}; use one of {THRESHOLDS} or a number in [0, 1]")
 
     def alignment(self, cut: float) -> Alignment:
@@ -395,7 +409,8 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
         return _relevance_scores(tuple(o.name for o in test), tuple(names), tuple(relevant_train), kname, decision,
                                  train_r, mask, want_train=want_train,
                                  calibrated="train-calibrated" in need and bool(relevant_train),
-                                 details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut)
+                                 details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut,
+                                 prior=(rs.prior_cut, rs.prior_weight))
     train_mean = loo_scores = loo_labels = None
     rows = test + train if want_train else test
     K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
@@ -418,7 +433,8 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
 def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_train: tuple[str, ...], kname: str,
                       decision: np.ndarray, train_r: np.ndarray, mask: np.ndarray, *, want_train: bool,
                       calibrated: bool, details: Mapping[str, Any], fallbacks: tuple[str, ...],
-                      natural_cut: float | None = None) -> AlignmentScores:
+                      natural_cut: float | None = None, prior: tuple[float | None, float] = (None, 0.5)
+                      ) -> AlignmentScores:
     """:class:`AlignmentScores` of one relevance pass (the relevance kernels' rule of the module docstring)."""
     K = np.where(mask[None, :], decision[:, None], 0.0)
     target = np.argmax(np.where(mask[None, :], K, -np.inf), axis=1) if len(train) else np.zeros(len(test), int)
@@ -435,7 +451,8 @@ def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_tr
     return AlignmentScores(test=test, train=train, relevant_train=relevant_train, K=K, decision=decision,
                            target=target, aligned=decision, kernel=kname, train_mean=train_mean,
                            loo_scores=loo_scores, loo_labels=loo_labels, fallbacks=fallbacks, details=dict(details),
-                           relevant_mask=mask.copy(), relevance_kernel=True, natural_cut=natural_cut)
+                           relevant_mask=mask.copy(), relevance_kernel=True, natural_cut=natural_cut,
+                           prior_cut=prior[0], prior_weight=prior[1])
 
 
 def trajectory_error_bounds(features: FeatureBatch, alignment: Alignment, lipschitz: float = 1.0) -> np.ndarray:

@@ -443,6 +443,11 @@ class Alignment:
         return float(lipschitz * n_steps * (max(gaps) if gaps else 0.0))
 
 
+def _unit_interval(instance: Any, attribute: attrs.Attribute, value: float) -> None:
+    if not (isinstance(value, (int, float)) and 0.0 <= float(value) <= 1.0):
+        raise ValidationError(f"{type(instance).__name__}.{attribute.name} must be a number in [0, 1], got {value!r}")
+
+
 def _vector(value: Any) -> np.ndarray:
     return np.asarray(value, dtype=float).reshape(-1)
 
@@ -467,6 +472,12 @@ class RelevanceScores:
     #: The cut the scores call for when they are calibrated probabilities with the intent's training evidence
     #: already folded in (1/2); None: the train-calibrated cut is placed on the training scores.
     cut: float | None = None
+    #: Where the scores' own scale puts the boundary before any training evidence (e.g. 1/2 for scores that
+    #: are 1/2 at the scene's mean), and its weight in the train-calibrated cut: ``prior_weight * prior_cut +
+    #: (1 - prior_weight) * leave-one-out cut`` (3-6 training objects place a cut noisily). None: the
+    #: leave-one-out cut alone.
+    prior_cut: float | None = attrs.field(default=None, validator=attrs.validators.optional(_unit_interval))
+    prior_weight: float = attrs.field(default=0.5, converter=float, validator=_unit_interval)
 
     def __attrs_post_init__(self) -> None:
         for name in ("relevance", "train_loo"):

@@ -318,6 +318,33 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
         GiftProbKernel(weighting="auc")
 
 
+def test_gift_prob_gives_the_prior_cut_one_half_with_the_weight_cut_prior():
+    """The train-calibrated cut of gift-prob: the leave-one-out cut averaged with 1/2 (cut_prior: its weight)."""
+    from gift.core.alignment import best_separating_cut, score_alignment
+
+    table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
+             "toothbrush": 0.4, "apple": 0.05}
+    rel = ("paintbrush", "sketchbook")
+
+    def scores(**opts):
+        k = GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                         probs=_probs_by_name(table)), combine="none", **opts)
+        return k.score(TEST, TRAIN, ART, rel), score_alignment(k, TEST, TRAIN, ART, relevant_train=rel,
+                                                                 need=("train-calibrated",))
+
+    rs, al = scores()
+    assert rs.prior_cut == 0.5 and rs.prior_weight == 0.5 and al.prior_cut == 0.5
+    loo = best_separating_cut([0.9, 0.8], [0.2, 0.1])
+    cut, note = al.threshold("train-calibrated")
+    assert cut == pytest.approx(0.5 * 0.5 + 0.5 * loo) and "prior cut 0.5 (weight 0.5)" in note
+    rs0, al0 = scores(cut_prior=0.0)
+    assert rs0.prior_cut is None and al0.threshold("train-calibrated") == (pytest.approx(loo), pytest.approx(
+        "leave-one-out over 2 relevant / 2 other training objects"))
+    assert scores(cut_prior=1.0)[1].threshold("train-calibrated")[0] == pytest.approx(0.5)
+    with pytest.raises(GiftError, match="gift-prob: cut_prior must be in"):
+        GiftProbKernel(cut_prior=1.5)
+
+
 # ----------------------------------------------------------------------------- the embedded model
 
 

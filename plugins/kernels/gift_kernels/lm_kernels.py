@@ -283,7 +283,8 @@ class GiftProbKernel(RelevanceKernel):
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
     the goal and the demonstrated training objects when ``relevant_train`` is given; ``"goal"``: from the
-    goal alone).
+    goal alone), ``cut_prior`` (weight of the scores' own boundary 1/2 against the leave-one-out cut in the
+    train-calibrated threshold; 0: the leave-one-out cut alone).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -294,7 +295,7 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first", calibration: str = "none") -> None:
+                 select: str = "first", calibration: str = "none", cut_prior: float = 0.5) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -314,6 +315,12 @@ class GiftProbKernel(RelevanceKernel):
         if select not in SELECT:
             raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
         self.select = select
+        if not 0.0 <= float(cut_prior) <= 1.0:
+            raise GiftError(f"gift-prob: cut_prior must be in [0, 1], got {cut_prior!r}")
+        #: Weight of the scale's own boundary, 1/2 (the scene's mean combined z-score; for ``combine="none"``
+        #: P(yes) = P(no)), against the leave-one-out cut in the train-calibrated threshold (0: that cut
+        #: alone). 1/2 chosen on gift-dev and lm-dev (docs/results/front_half.md).
+        self.cut_prior = float(cut_prior)
         #: ``"none"``: z-scores per intent with reliability weights, the cut placed on the training scores;
         #: ``"pooled"``: the shipped :class:`~gift_kernels.calibration.TermCalibration`, updated per intent with
         #: the relevant training objects (cut 1/2); or the path of a calibration file. Default ``"none"``: the
@@ -348,7 +355,8 @@ class GiftProbKernel(RelevanceKernel):
     def __repr__(self) -> str:
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
-                f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r})")
+                f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
+                f"cut_prior={self.cut_prior})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -587,7 +595,7 @@ class GiftProbKernel(RelevanceKernel):
             rel = self._relevant_mask(train, (), lo_train)
         details["terms"] = {"lm": {"test": lo_test.tolist(), "train": lo_train.tolist()}}
         if self.combine == "none":
-            return RelevanceScores(_sigmoid(lo_test), _sigmoid(lo_train), rel, details)
+            return RelevanceScores(_sigmoid(lo_test), _sigmoid(lo_train), rel, details, **self._prior())
         emb = np.concatenate([self._embed_scores(test, train, rel, False) if test else np.zeros(0),
                               self._embed_scores(train, train, rel, True)])
         details["terms"]["language"] = {"test": emb[: len(test)].tolist(), "train": emb[len(test):].tolist()}
@@ -611,7 +619,11 @@ class GiftProbKernel(RelevanceKernel):
         weights = {t: v / total for t, v in w.items()}
         z = sum(weights[t] * terms[t] for t in terms)
         details["weights"] = weights
-        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details)
+        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details, **self._prior())
+
+    def _prior(self) -> dict[str, Any]:
+        """The prior cut of the scores (1/2, where the log-odds or the combined z-score is 0) and its weight."""
+        return {"prior_cut": 0.5, "prior_weight": self.cut_prior} if self.cut_prior > 0 else {}
 
     @staticmethod
     def _split(train: Sequence[ObjectSpec], rel: np.ndarray) -> tuple[list[str], list[str]]:
