@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -236,3 +237,74 @@ def test_gift_report_writes_the_page_again_from_the_folder(viewing_run, browser,
     open_page(browser, copy / "report.html")
     assert len(browser.find_elements("css selector", "img")) >= 3 * len(_spec(cfg).test)
     assert console_errors(browser) == []
+
+
+def test_questions_asked_section_in_the_browser(viewing_run, browser, tmp_path):
+    """The "Questions asked" section on a real run: gift-prob's real scores of the run, two uncertainty
+    questions answered from the suite's labels (the chain's own query stage), and the committed query curves
+    (docs/results/queries/curves.json) through ``gift report --query-curves``; drawn, hoverable, offline."""
+    import shutil
+
+    import attrs
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    from gift.core.alignment import AlignmentScores
+    from gift.study.chain import query_label, query_stage
+
+    cfg, out, _, _ = viewing_run
+    copy = tmp_path / "queried"
+    shutil.copytree(out, copy, ignore=shutil.ignore_patterns("stages", "report.html"))
+    qcfg = attrs.evolve(cfg, queries=2, query_policy="uncertainty")
+    spec = _spec(cfg)
+    data = json.loads((copy / "results.json").read_text())
+    rec = data["alignment"][INTENT]["gift-prob"]
+    q = query_stage(qcfg, spec, AlignmentScores.from_dict(rec["scores"]))
+    rec["queries"] = json.loads(json.dumps(q))
+    row = query_label("gift-prob", qcfg)
+    data["rq2"][INTENT][row] = {q["threshold"]: q["metrics"][q["threshold"]]}
+    (copy / "results.json").write_text(json.dumps(data))
+    curves_file = Path(__file__).resolve().parents[2] / "docs" / "results" / "queries" / "curves.json"
+    curves = json.loads(curves_file.read_text())
+    done = subprocess.run([sys.executable, "-m", "gift.cli", "report", str(copy), "--no-render",
+                           "--query-curves", str(curves_file)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+
+    open_page(browser, copy / "report.html")
+    ids = [e.get_attribute("id") for e in browser.find_elements(By.CSS_SELECTOR, "section")]
+    assert ids[:3] == ["run", "headline", "queries"]
+    assert browser.find_elements(By.CSS_SELECTOR, ".section-error") == []
+    section = browser.find_element(By.ID, "queries")
+    # the questions in the order asked, each with the simulated human's answer (the suite's label)
+    rows = section.find_elements(By.CSS_SELECTOR, "tr.query-row")
+    assert [(r.get_attribute("data-intent"), r.get_attribute("data-kernel")) for r in rows] == [(INTENT, "gift-prob")]
+    asked = rows[0].find_elements(By.CSS_SELECTOR, "li[data-object]")
+    assert [li.get_attribute("data-object") for li in asked] == [a["object"] for a in q["answers"]]
+    labels = {t.object: t.relevant for t in spec.test}
+    assert q["asked"] == len(asked) > 0
+    for li, a in zip(asked, q["answers"]):
+        assert a["relevant"] == labels[a["object"]]
+        assert ("yes, relevant" if a["relevant"] else "no, not relevant") in li.text
+    f1 = q["metrics"][q["threshold"]]["all"]["f1"]
+    assert f"{f1:.3f}" in rows[0].text
+    # the before/after bars and one F1 and one win-rate plot per run of the curves file, drawn on screen
+    assert section.find_elements(By.CSS_SELECTOR, 'svg[data-plot="queries-f1"] rect.bar')
+    n_runs = len(curves["runs"])
+    for key in ("f1", "win"):
+        plots = section.find_elements(By.CSS_SELECTOR, f'svg[data-plot="query-curve-{key}"]')
+        assert len(plots) == n_runs
+        lines = section.find_elements(By.CSS_SELECTOR, f'svg[data-plot="query-curve-{key}"] polyline.curve')
+        assert lines and all(ln.size["width"] > 0 for ln in lines)
+    # a point of a curve names its run, policy, number of questions and value under the pointer
+    run, sim = next(iter(curves["runs"].items()))
+    first = section.find_elements(By.CSS_SELECTOR, 'svg[data-plot="query-curve-f1"]')[0]
+    pt = _uncovered(browser, first.find_elements(By.CSS_SELECTOR, "circle.pt")[::-1])
+    ActionChains(browser).move_to_element(pt).perform()
+    time.sleep(0.1)
+    tip = browser.find_element(By.ID, "tip")
+    assert tip.is_displayed() and tip.text == pt.get_attribute("data-tip")
+    policy = pt.get_attribute("data-series")
+    points = [f"{run}: {policy}, {k} question(s) per intent: alignment F1 (pooled) {v:.3f}"
+              for k, v in zip(sim["grid"], sim["curves"][policy]["f1"]) if v is not None]
+    assert any(tip.text.startswith(p) for p in points)
+    assert console_errors(browser) == [] and network_fetches(browser) == []
