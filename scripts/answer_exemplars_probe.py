@@ -4,9 +4,12 @@ For each intent of ``gift evaluate-alignment --kernels gift-prob`` results (the 
 ``docs/results/data/front_half/``), the uncertainty policy asks k questions (the unanswered test object
 nearest the cut), answered from the suite's labels.
 
-- ``cut-only``, gift's rule: the kernel's scores stay; answers join the evidence of the train-calibrated
-  cut (the best separating cut of the leave-one-out training scores and the answered objects, averaged
-  with 1/2 as gift-prob's prior cut); answered objects are fixed to their answer.
+- ``cut-only``: the kernel's scores stay; answers join the evidence of the train-calibrated cut (the
+  widest-gap best separating cut of the leave-one-out training scores and the answered objects, averaged
+  with 1/2 as gift-prob's prior cut); answered objects are fixed to their answer. This is close to, not
+  the same as, gift's rule (``gift.core.queries``: the best cut *nearest* the cut without answers), so its
+  numbers differ a little from docs/results/queries.md; both arms use the same rule, which is what the
+  comparison needs.
 - ``exemplars``: also re-ranks. A "yes" joins the relevant exemplars and a "no" the others in the
   contrastive MiniLM term (largest cosine to a relevant exemplar minus largest cosine to another), the
   reliability weights are re-estimated with the answered objects as evidence and both terms re-z-scored;
@@ -26,25 +29,16 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from gift_kernels.lm_kernels import _sigmoid, _zscore, separation_weight
 
 import gift
 from gift.core.alignment import best_separating_cut
-from gift.core.metrics import binary_metrics, roc_auc
+from gift.core.metrics import binary_metrics
 
 DATA = Path(__file__).resolve().parents[1] / "docs" / "results" / "data" / "front_half"
 FILES = ("gift-dev-inferred", "lm-dev-inferred", "gift-dev-ground-truth", "lm-dev-ground-truth",
          "gift-paper-inferred", "gift-paper-ground-truth")
 PRIOR_CUT, PRIOR_WEIGHT = 0.5, 0.5
-
-
-def _z(x: np.ndarray) -> np.ndarray:
-    sd = x.std()
-    return (x - x.mean()) / sd if sd > 1e-9 else x - x.mean()
-
-
-def _separation(v: np.ndarray, labels: np.ndarray) -> float:
-    auc = roc_auc(v, labels)
-    return float("nan") if math.isnan(auc) else max(auc - 0.5, 0.0)
 
 
 def rescore(lo: np.ndarray, sim: np.ndarray, pos: list[int], neg: list[int], evidence: list[int],
@@ -56,12 +50,12 @@ def rescore(lo: np.ndarray, sim: np.ndarray, pos: list[int], neg: list[int], evi
     for i in range(len(lo)):
         p, q = [j for j in pos if j != i], [j for j in neg if j != i]
         emb[i] = (sim[i, p].max() if p else 0.0) - (sim[i, q].max() if q else 0.0)
-    terms = {"lm": _z(lo), "language": _z(emb)}
-    w = {t: 0.5 * _separation(v[evidence], labels) for t, v in terms.items()}
+    terms = {"lm": _zscore(lo), "language": _zscore(emb)}
+    w = {t: 0.5 * separation_weight(v[evidence], labels) for t, v in terms.items()}
     if any(math.isnan(v) for v in w.values()) or sum(w.values()) <= 0:
         w = {"lm": 0.5, "language": 0.5}
     s = sum(w[t] / sum(w.values()) * terms[t] for t in terms)
-    return 1.0 / (1.0 + np.exp(-s))
+    return _sigmoid(s)
 
 
 def pooled_f1(path: Path, k: int, mode: str, language) -> float:
