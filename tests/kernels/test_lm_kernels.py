@@ -421,6 +421,35 @@ def test_gift_prob_on_the_embedded_model_recovers_the_category_of_an_object_boun
 
 
 @pytest.mark.slow
+def test_gift_prob_ladder_on_the_embedded_model_names_the_class_a_generic_inferred_goal_misses(embedded_lm):
+    """lm-dev's protect_electronics (a development suite) with the generic goal Call 1 of the 1.5B model wrote
+    for it. Measured (docs/results/front_half.md): the goal's category ("objects to carry") ranks the test
+    objects at LM-only AUC 0.64; the ladder's rungs, named from the laptop and the phone, at 0.96. The
+    ladder's rungs also come back as intent candidates for the questions of gift.core.queries."""
+    from gift.core.alignment import score_alignment
+    from gift.core.metrics import roc_auc
+    from gift.core.queries import QueryProblem
+
+    suite = load_suite(SUITE)
+    spec = suite.intent("protect_electronics")
+    test, train = suite.specs(spec.test_objects), suite.specs(spec.train_objects)
+    labels = [t.relevant for t in spec.test]
+    intent = Intent(text="The person wanted to carry the mug to the goal spot as quickly as possible.",
+                    source="inferred")
+    plain = GiftProbKernel(lm=embedded_lm, combine="none").score(test, train, intent, spec.relevant_train)
+    k = GiftProbKernel(lm=embedded_lm, ladder="inferred")
+    sc = score_alignment(k, test, train, intent, relevant_train=spec.relevant_train)
+    rungs = [c.lower() for c in sc.details["ladder"]["categories"]]
+    assert 2 <= len(rungs) <= 3 and not any(o in c for c in rungs for o in ("laptop", "phone")), rungs
+    assert any(w in " ".join(rungs) for w in ("electronic", "digital", "device", "comput", "gadget")), rungs
+    lm_ladder = np.asarray(sc.details["terms"]["lm"]["test"])
+    assert roc_auc(lm_ladder, labels) >= 0.85 and roc_auc(lm_ladder, labels) > roc_auc(plain.relevance, labels) + 0.1
+    problem = QueryProblem.of(sc)
+    assert len(problem.candidates) == 2 + len(rungs)  # the averaged kernel, the goal's category, each rung
+    assert any(name.startswith("rung 1: ") for name in problem.candidates)
+
+
+@pytest.mark.slow
 def test_gift_and_lm_no_intent_on_the_embedded_model_map_every_object_within_the_call_budget(embedded_lm):
     test = [ObjectSpec("crayons", "sticks of colored wax"), ObjectSpec("apple", "a round red fruit")]
     k = MappingKernel(lm=embedded_lm, samples=2)
@@ -485,6 +514,55 @@ def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_
     assert first.details["category"] == "sketchbooks" and first.details["candidates"][0]["chosen"]
 
 
+def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_objects_leaving_each_one_out():
+    """ladder="inferred": for an inferred intent the LM names three rungs (narrow to broad) of what the
+    demonstrated objects share, one ladder per training object without it; the LM term is the mean of the
+    z-scored log-odds under the goal's category and each rung. A stated intent is scored as before."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            q = messages[-1].content
+            if "specially: sketchbook.\n" in q:
+                return json.dumps({"narrow": "drawing books", "middle": "paper goods", "broad": "Paper goods."})
+            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
+           "creative things": {"paintbrush": 0.8, "sketchbook": 0.8, "crayons": 0.8}}
+
+    def probs(text):
+        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        p = yes.get(cat, {}).get(name, 0.3)
+        return {"yes": p, "no": 1.0 - p}
+
+    lm = ScriptedLM(answer=answer, probs=probs)
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", ladder="inferred")
+    rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+    assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things"]
+    ladders = [c[0][-1].content for c in lm.calls if c[0][0].content == prompts.LADDER_SYSTEM]
+    assert len(ladders) == 1 + len(TRAIN)  # the full ladder, then one without each training object
+    assert ladders[0].startswith("Objects the person treated specially: paintbrush, sketchbook.\n"
+                                 "Objects they treated like any other: banana, coffee mug.")
+    # the paintbrush's rungs are named without it; duplicates ("paper goods" twice) collapse to the last rung
+    assert k.ladder(["sketchbook"], ["banana", "coffee mug"]) == ("drawing books", "paper goods")
+    asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
+    assert any(q.startswith("Is a paintbrush (a brush for paint) one of the paper goods?") for q in asked)
+    # the goal's category ranks the banana first; the rungs outvote it: crayons first, apple below
+    order = np.argsort(-rs.relevance)
+    assert TEST[order[0]].name == "crayons" and rs.relevance[2] < rs.relevance[0]
+    lo = [np.array(t["test"] + t["train"]) for t in rs.details["ladder"]["terms"]]
+    assert len(lo) == 3 and np.allclose(lo[1][:3], np.log(np.array([0.9, 0.3, 0.3]) / np.array([0.1, 0.7, 0.7])))
+    # a stated intent: no ladder; ladder="always" asks it for a stated intent too; bad option named
+    stated = GiftProbKernel(lm=lm, combine="none", ladder="inferred").score(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
+    assert "ladder" not in stated.details
+    assert "ladder" in GiftProbKernel(lm=lm, combine="none", ladder="always").score(
+        TEST, TRAIN, ART, ("paintbrush", "sketchbook")).details
+    with pytest.raises(GiftError, match="ladder"):
+        GiftProbKernel(ladder="sometimes")
+    with pytest.raises(ValueError, match="handled object"):
+        prompts.ladder_messages([], ["banana"])
+
+
 def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_suite():
     """The category prompts' worked examples: none of their objects is in a suite catalog, and no word of
     their goals and categories is a content word of a suite's goal (beyond function words and generic nouns
@@ -499,6 +577,7 @@ def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_
     goal_words = {w for s in suites for i in s.intents for w in re.findall(r"[a-z]+", i.text.lower())} - stop
     examples = [(g, h + a, c) for g, h, a, c in prompts.CATEGORY_EXAMPLES_WITH_OBJECTS]
     examples += [(g, (), c) for g, c in prompts.CATEGORY_EXAMPLES]
+    examples += [("", h + a, " ".join(names)) for h, a, names in prompts.LADDER_EXAMPLES]
     for goal, objs, category in examples:
         assert not {o.lower() for o in objs} & objects, objs
         words = set(re.findall(r"[a-z]+", f"{goal} {category}".lower())) - stop

@@ -236,6 +236,7 @@ WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
+LADDER = ("never", "inferred", "always")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -284,7 +285,11 @@ class GiftProbKernel(RelevanceKernel):
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
     the goal and the demonstrated training objects when ``relevant_train`` is given; ``"goal"``: from the
     goal alone), ``cut_prior`` (weight of the scores' own boundary 1/2 against the leave-one-out cut in the
-    train-calibrated threshold; 0: the leave-one-out cut alone).
+    train-calibrated threshold; 0: the leave-one-out cut alone), ``ladder`` (``"inferred"``: for an intent
+    inferred from demonstrations, also name three categories, narrow to broad, from the demonstrated objects
+    alone and average the z-scored log-odds under all four; the scene under each category alone is reported
+    as an intent candidate that answers can pick, see :mod:`gift.core.queries`; ``"always"``; ``"never"``, the
+    default: on the development suites it ranks better but cuts no better, docs/results/front_half.md).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -295,7 +300,8 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first", calibration: str = "none", cut_prior: float = 0.5) -> None:
+                 select: str = "first", calibration: str = "none", cut_prior: float = 0.5,
+                 ladder: str = "never") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -315,6 +321,14 @@ class GiftProbKernel(RelevanceKernel):
         if select not in SELECT:
             raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
         self.select = select
+        if ladder not in LADDER:
+            raise GiftError(f"gift-prob: ladder must be one of {LADDER}, got {ladder!r}")
+        #: When to add the category ladder (:meth:`ladder`): three names, narrow to broad, of what the
+        #: demonstrated training objects share, asked without the goal; the LM term becomes the mean of the
+        #: z-scored log-odds under the goal's category and each rung. ``"inferred"``: only for an intent
+        #: inferred from demonstrations (whose goal text the small model wrote); ``"always"``; ``"never"``.
+        self.ladder_mode = ladder
+        self._ladder_memo: dict[tuple, tuple[str, ...]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
             raise GiftError(f"gift-prob: cut_prior must be in [0, 1], got {cut_prior!r}")
         #: Weight of the scale's own boundary, 1/2 (the scene's mean combined z-score; for ``combine="none"``
@@ -356,7 +370,7 @@ class GiftProbKernel(RelevanceKernel):
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
-                f"cut_prior={self.cut_prior})")
+                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -435,6 +449,61 @@ class GiftProbKernel(RelevanceKernel):
         with self._lock:
             self._category_memo[key] = cat
         return cat
+
+    def ladder(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> tuple[str, ...]:
+        """Names, narrow to broad, of what the ``handled`` training objects share that the ``left_alone``
+        ones do not (one greedy call per pair of lists, no goal text; duplicates dropped). An answer with no
+        usable name gives ``()``, with a warning."""
+        key = (tuple(handled), tuple(left_alone))
+        with self._lock:
+            if key in self._ladder_memo:
+                return self._ladder_memo[key]
+        from gift_llm.structured import ask_dict
+
+        self.calls += 1
+        levels = prompts.LADDER_LEVELS
+        try:
+            ans = ask_dict(self.lm, prompts.ladder_messages(handled, left_alone), temperature=0.0, max_tokens=96,
+                           json_schema=schemas.ladder_schema(levels) if self.constrained else None,
+                           required_keys=levels)
+        except LMAnswerError as e:
+            warnings.warn(f"gift-prob: the LM named no category ladder for {', '.join(handled)} (answer "
+                          f"{e.raw[:80]!r}); using the goal's category alone", stacklevel=2)
+            ans = {}
+        names: list[str] = []
+        for lv in levels:
+            cat = prompts.parse_category(ans[lv]) if isinstance(ans.get(lv), str) else None
+            if cat and cat.lower() not in [n.lower() for n in names]:
+                names.append(cat)
+        with self._lock:
+            self._ladder_memo[key] = tuple(names)
+        return tuple(names)
+
+    def _uses_ladder(self, intent: Intent) -> bool:
+        return self.ladder_mode == "always" or (self.ladder_mode == "inferred" and intent.source == "inferred")
+
+    def _ladder_term(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent,
+                     rel: np.ndarray, lo: np.ndarray, details: dict[str, Any]) -> np.ndarray:
+        """The LM term ``[n_test + n_train]`` with the ladder: the mean of the z-scored log-odds ``lo`` (the
+        goal's category) and of each rung's log-odds; a training object's rungs are named without it
+        (leave-one-out; with no relevant partner left, the full ladder, as in :meth:`_categories`)."""
+        handled, alone = self._split(train, rel)
+        full = self.ladder(handled, alone)
+        if not full:
+            return lo
+        rungs = []
+        for r, name in enumerate(full):
+            cats = [name] * len(test)
+            for o in train:
+                h = [n for n in handled if n != o.name]
+                a = [n for n in alone if n != o.name]
+                loo = self.ladder(h, a) if h else full
+                cats.append(loo[r] if r < len(loo) else (loo[-1] if loo else name))
+            rungs.append(self.log_odds(list(test) + list(train), intent, cats))
+        details["ladder"] = {"categories": list(full), "goal": lo.tolist(),
+                             "terms": [{"test": v[: len(test)].tolist(), "train": v[len(test):].tolist()}
+                                       for v in rungs]}
+        return np.mean([_zscore(v) for v in [lo, *rungs]], axis=0)
 
     def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent,
                  categories: Sequence[str] | None = None) -> np.ndarray:
@@ -590,9 +659,11 @@ class GiftProbKernel(RelevanceKernel):
             lo = self.log_odds(test + train, intent)
             if uses_category:
                 details["category"] = self.category(intent)
-        lo_test, lo_train = lo[: len(test)], lo[len(test):]
         if rel is None:
-            rel = self._relevant_mask(train, (), lo_train)
+            rel = self._relevant_mask(train, (), lo[len(test):])
+        if self._uses_ladder(intent) and rel.any() and uses_category:
+            lo = self._ladder_term(test, train, intent, rel, lo, details)
+        lo_test, lo_train = lo[: len(test)], lo[len(test):]
         details["terms"] = {"lm": {"test": lo_test.tolist(), "train": lo_train.tolist()}}
         if self.combine == "none":
             return RelevanceScores(_sigmoid(lo_test), _sigmoid(lo_train), rel, details, **self._prior())
@@ -607,19 +678,40 @@ class GiftProbKernel(RelevanceKernel):
                                       "pooled_intercept": self.calibration.intercept}
             p = cal.probability(X)
             return RelevanceScores(p[: len(test)], p[len(test):], rel, details, cut=0.5)
-        ref = slice(None) if self.standardize == "pooled" else slice(len(test), None)
+        z, details["weights"] = self._combine(lo, emb, rel, len(test))
+        if "ladder" in details:
+            self._ladder_views(details, emb, rel, len(test))
+        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details, **self._prior())
+
+    def _combine(self, lo: np.ndarray, emb: np.ndarray, rel: np.ndarray, n_test: int
+                 ) -> tuple[np.ndarray, dict[str, float]]:
+        """The combined z-score ``[n_test + n_train]`` of the LM log-odds ``lo`` and the MiniLM term ``emb``
+        (test objects first), and the weight of each term."""
+        ref = slice(None) if self.standardize == "pooled" else slice(n_test, None)
         terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
         w = {"lm": 1.0 - self.weight, "language": self.weight}
         if self.weighting == "reliability":
-            sep = {t: separation_weight(v[len(test):], rel) for t, v in terms.items()}
+            sep = {t: separation_weight(v[n_test:], rel) for t, v in terms.items()}
             scaled = {t: w[t] * sep[t] for t in terms}
             if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
                 w = scaled
         total = sum(w.values())
         weights = {t: v / total for t, v in w.items()}
-        z = sum(weights[t] * terms[t] for t in terms)
-        details["weights"] = weights
-        return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details, **self._prior())
+        return sum(weights[t] * terms[t] for t in terms), weights
+
+    def _ladder_views(self, details: dict[str, Any], emb: np.ndarray, rel: np.ndarray, n_test: int) -> None:
+        """Report the scene under the goal's category alone and under each rung alone (each combined with
+        the MiniLM term as the kernel's own score is) as intent candidates (``details["candidates"]``, on the
+        relevance scale), so answers from the human can pick one (:mod:`gift.core.queries`, rule 3)."""
+        lad = details["ladder"]
+        views = [("goal's category: " + str(details.get("category")), np.asarray(lad["goal"]))]
+        views += [(f"rung {k + 1}: {cat}", np.asarray(t["test"] + t["train"]))
+                  for k, (cat, t) in enumerate(zip(lad["categories"], lad["terms"]))]
+        cands = details.setdefault("candidates", [])
+        for name, lo in views:
+            z, _ = self._combine(lo, emb, rel, n_test)
+            cands.append({"name": name, "relevance": _sigmoid(z[:n_test]).tolist(),
+                          "train_loo": _sigmoid(z[n_test:]).tolist(), "chosen": False})
 
     def _prior(self) -> dict[str, Any]:
         """The prior cut of the scores (1/2, where the log-odds or the combined z-score is 0) and its weight."""

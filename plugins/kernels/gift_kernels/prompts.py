@@ -213,6 +213,47 @@ def category_from_objects_messages(goal: str | None, handled: Sequence[str],
     return tuple(msgs)
 
 
+#: The breadths of the category ladder (:func:`ladder_messages`), narrowest first.
+LADDER_LEVELS: tuple[str, ...] = ("narrow", "middle", "broad")
+
+LADDER_SYSTEM = ("You name what a set of household objects have in common, at three breadths: narrow (just "
+                 "this kind), middle, and broad (a wider family that still leaves the other objects out). Each "
+                 "name is a short plural noun phrase, never one object's name. Reply with one JSON object and "
+                 'nothing else: {"narrow": "...", "middle": "...", "broad": "..."}')
+
+#: Worked examples of the ladder: the objects of :data:`CATEGORY_EXAMPLES_WITH_OBJECTS` (no object and no
+#: kind of goal of any shipped suite; checked by a test), named at three breadths.
+LADDER_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, str]], ...] = (
+    (("aquarium net", "fish food flakes"), ("tripod", "kettle"),
+     ("aquarium supplies", "pet care supplies", "things for looking after animals")),
+    (("car wax tin", "windshield squeegee"), ("toaster", "desk lamp"),
+     ("car cleaning things", "vehicle care products", "things for maintenance")),
+    (("bag of marbles", "box of push pins"), ("beach ball", "floor cushion"),
+     ("things with small parts", "loose little pieces", "choking hazards")),
+    (("party hat", "confetti cannon"), ("tire gauge", "bath mat"),
+     ("party supplies", "celebration things", "things for entertainment")),
+)
+
+
+def _ladder_question(handled: Sequence[str], left_alone: Sequence[str]) -> str:
+    return (f"Objects the person treated specially: {', '.join(handled)}.\n"
+            f"Objects they treated like any other: {', '.join(left_alone) or 'none'}.\n"
+            "What do the specially treated objects have in common?")
+
+
+def ladder_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+    """Ask for three names, narrow to broad, of what the ``handled`` training objects share that the
+    ``left_alone`` ones do not (no goal text: the question a small model answers best)."""
+    if not handled:
+        raise ValueError("ladder_messages needs at least one handled object")
+    msgs = [Message("system", LADDER_SYSTEM)]
+    for h, a, names in LADDER_EXAMPLES:
+        msgs += [Message("user", _ladder_question(h, a)),
+                 Message("assistant", json.dumps(dict(zip(LADDER_LEVELS, names))))]
+    msgs.append(Message("user", _ladder_question(handled, left_alone)))
+    return tuple(msgs)
+
+
 def parse_category(answer: str, max_words: int = 8) -> str | None:
     """The noun phrase of a category answer (first line, quotes, a leading "the" and end punctuation
     removed), or ``None`` when there is none or it is longer than ``max_words`` words."""

@@ -112,3 +112,8 @@ def mapping_schema(test: Iterable[str], train: Iterable[str]) -> dict[str, Any]:
 def category_schema(max_chars: int = CATEGORY_MAX_CHARS) -> dict[str, Any]:
     """gift-prob's category call: ``{"category": <1 to max_chars characters>}``."""
     return closed_object({"category": text(max_chars)})
+
+
+def ladder_schema(levels: Iterable[str], max_chars: int = CATEGORY_MAX_CHARS) -> dict[str, Any]:
+    """gift-prob's category ladder: ``{<level>: <1 to max_chars characters>, ...}`` for each level."""
+    return closed_object({lv: text(max_chars) for lv in levels})
