@@ -50,7 +50,8 @@ def run(args: argparse.Namespace) -> dict:
     from gift.study.sweeps import suite_provenance, versions
     from gift_experiments import query_curves as qc
 
-    out: dict = {"command": "python scripts/query_curves.py " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
+    out: dict = {"kernel": args.kernel,
+                 "command": "python scripts/query_curves.py " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
                  "git": git_commit(), "code_version": code_version(), "versions": versions(), "runs": {},
                  "suites": {}, "failures": []}
     t_all = time.perf_counter()
@@ -93,11 +94,18 @@ def run(args: argparse.Namespace) -> dict:
     return out
 
 
+def figure_dir(md: Path) -> str:
+    """The directory, next to the page ``md``, of its figures and curves.json: ``queries`` for queries.md,
+    else the page's own stem (so a second page never overwrites the first one's figures)."""
+    return "queries" if md.stem == "queries" else md.stem
+
+
 def write(result: dict, md: Path) -> None:
     from gift.core.serialization import write_json
     from gift_experiments import query_curves as qc
 
-    fig_dir = md.parent / "queries"
+    sub = figure_dir(md)
+    fig_dir = md.parent / sub
     fig_dir.mkdir(parents=True, exist_ok=True)
     write_json(fig_dir / "curves.json", result, indent=1)
     sources = list(dict.fromkeys(r["intent_source"] for r in result["runs"].values()))
@@ -109,6 +117,11 @@ def write(result: dict, md: Path) -> None:
                                           f"F1 and win rate after k questions per intent")
     git = result.get("git") or {}
     lm = result.get("lm") or {}
+    kernel = result.get("kernel", "gift-prob")
+    recipe = ("`gift-prob` with its default recipe at the commit below, the one measured in "
+              "[the front half](front_half.md)." if kernel == "gift-prob" else
+              f"`{kernel}`: `gift-prob` with these options, otherwise its default recipe at the commit below "
+              "(the default is measured in [queries.md](queries.md) and [the front half](front_half.md)).")
     lines = ["# Asking instead of guessing: query policies and abstention", "",
              "When the intent-conditioned kernel is unsure, gift can ask the human \"is this object part of the "
              "goal?\" about a few test objects and re-score the scene with the answers, or abstain on an object "
@@ -125,15 +138,14 @@ def write(result: dict, md: Path) -> None:
              f"the intents whose test scenes fit the table. `random` is the mean over {result['random_seeds']} "
              "seeds (± 1 standard error over seeds in the tables and the figure).", "",
              "!!! note \"Which recipe\"",
-             "    `gift-prob` with its default recipe at the commit below, the one measured in "
-             "[the front half](front_half.md). Inferred intents: the relevant training objects and the intent "
+             f"    {recipe} Inferred intents: the relevant training objects and the intent "
              "come from the demonstrations alone.", "",
              "Command:", "", "```", result["command"], "```", "",
              f"Commit `{(git.get('commit') or '?')[:10]}`{' (dirty)' if git.get('dirty') else ''}, code version "
              f"`{result.get('code_version', '?')[:12]}`, LM `{lm.get('identity', '–')}` (model sha256 "
              f"`{(lm.get('model_sha256') or '–')[:12]}`), {result['seconds']:.0f} s. Suites: " +
              ", ".join(f"`{n}` (sha256 `{(p.get('sha256') or '?')[:12]}`)" for n, p in result["suites"].items()) +
-             ". Every number is in [`queries/curves.json`](queries/curves.json).", ""]
+             f". Every number is in [`{sub}/curves.json`]({sub}/curves.json).", ""]
     lines += ["## In short", ""]
     for label, r in result["runs"].items():
         t, grid = r["target"], r["grid"]
@@ -166,7 +178,7 @@ def write(result: dict, md: Path) -> None:
               "- Win rates depend on the simulator's scenes at the commit below: the k = 0 row is `gift reproduce "
               "--kernels gift-prob` at the same commit and sizes.", ""]
     for source in sources:
-        lines += [f"## {source.capitalize()} intents", "", f"![query curves, {source} intents](queries/{source}.png)", ""]
+        lines += [f"## {source.capitalize()} intents", "", f"![query curves, {source} intents]({sub}/{source}.png)", ""]
         for label, r in result["runs"].items():
             if r["intent_source"] != source:
                 continue
@@ -250,7 +262,7 @@ def main(argv: list[str] | None = None) -> int:
         log.error("nothing ran: %s", result["failures"])
         return 1
     write(result, Path(args.out))
-    print(f"wrote {args.out} and {Path(args.out).parent / 'queries'}")
+    print(f"wrote {args.out} and {Path(args.out).parent / figure_dir(Path(args.out))}")
     return 0
 
 
