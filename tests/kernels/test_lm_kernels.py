@@ -563,6 +563,25 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
         prompts.ladder_messages([], ["banana"])
 
 
+def test_gift_prob_ladder_that_names_nothing_warns_and_keeps_the_goals_category():
+    """A ladder answer with no usable name (after the repairs) is no rung: a warning names the objects, and the
+    scene is scored under the goal's category alone, as without the ladder."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return "I cannot tell."
+        return category_json("art supplies")
+
+    lm = ScriptedLM(answer=answer, probs=_probs_by_name({"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2,
+                                                          "coffee mug": 0.1, "crayons": 0.7, "toothbrush": 0.4,
+                                                          "apple": 0.05}))
+    inferred = Intent(text="The person wanted to pick up the sketchbook.", source="inferred")
+    with pytest.warns(UserWarning, match="no category ladder for paintbrush, sketchbook"):
+        rs = GiftProbKernel(lm=lm, combine="none", ladder="inferred").score(TEST, TRAIN, inferred,
+                                                                            ("paintbrush", "sketchbook"))
+    plain = GiftProbKernel(lm=lm, combine="none").score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+    assert "ladder" not in rs.details and np.allclose(rs.relevance, plain.relevance)
+
+
 def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_suite():
     """The category prompts' worked examples: none of their objects is in a suite catalog, and no word of
     their goals and categories is a content word of a suite's goal (beyond function words and generic nouns
