@@ -559,6 +559,8 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
         TEST, TRAIN, ART, ("paintbrush", "sketchbook")).details
     with pytest.raises(GiftError, match="ladder"):
         GiftProbKernel(ladder="sometimes")
+    with pytest.raises(GiftError, match="calibration"):
+        GiftProbKernel(ladder="inferred", calibration="pooled")
     with pytest.raises(ValueError, match="handled object"):
         prompts.ladder_messages([], ["banana"])
 

@@ -323,6 +323,9 @@ class GiftProbKernel(RelevanceKernel):
         self.select = select
         if ladder not in LADDER:
             raise GiftError(f"gift-prob: ladder must be one of {LADDER}, got {ladder!r}")
+        if ladder != "never" and calibration != "none":
+            raise GiftError("gift-prob: a calibration is fitted on one category's log-odds; the ladder averages "
+                            "z-scores of several, so use ladder='never' with calibration")
         #: When to add the category ladder (:meth:`ladder`): three names, narrow to broad, of what the
         #: demonstrated training objects share, asked without the goal; the LM term becomes the mean of the
         #: z-scored log-odds under the goal's category and each rung. ``"inferred"``: only for an intent
