@@ -32,14 +32,6 @@ from gift.core.metrics import roc_auc
 LEVELS = prompts.LADDER_LEVELS
 
 
-def ladder_messages(handled, alone):
-    return prompts.ladder_messages(handled, alone)
-
-
-def ladder_schema():
-    return schemas.ladder_schema(LEVELS)
-
-
 def main(suites):
     lm = get_default_lm()
     k = GiftProbKernel(lm=lm, combine="none")
@@ -56,8 +48,8 @@ def main(suites):
             labels = np.array([t.relevant for t in spec.test])
             intent = Intent(text=rec["intent_text"], source="inferred")
             cur = rec["details"]["category"]
-            ans = ask_dict(lm, ladder_messages(handled, alone), temperature=0.0, max_tokens=80,
-                           json_schema=ladder_schema(), required_keys=LEVELS)
+            ans = ask_dict(lm, prompts.ladder_messages(handled, alone), temperature=0.0, max_tokens=80,
+                           json_schema=schemas.ladder_schema(LEVELS), required_keys=LEVELS)
             cats = {lv: prompts.parse_category(ans[lv]) or ans[lv] for lv in LEVELS}
             lo = {"current": k.log_odds(test, intent, [cur] * len(test))}
             for lv in LEVELS:

@@ -543,7 +543,8 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
     assert len(ladders) == 1 + len(TRAIN)  # the full ladder, then one without each training object
     assert ladders[0].startswith("Objects the person treated specially: paintbrush, sketchbook.\n"
                                  "Objects they treated like any other: banana, coffee mug.")
-    # the paintbrush's rungs are named without it; duplicates ("paper goods" twice) collapse to the last rung
+    # the paintbrush's rungs are named without it; a repeated name ("paper goods" twice) is dropped, and its
+    # missing third rung repeats the last one
     assert k.ladder(["sketchbook"], ["banana", "coffee mug"]) == ("drawing books", "paper goods")
     asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
     assert any(q.startswith("Is a paintbrush (a brush for paint) one of the paper goods?") for q in asked)

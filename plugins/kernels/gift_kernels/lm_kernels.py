@@ -494,15 +494,13 @@ class GiftProbKernel(RelevanceKernel):
         full = self.ladder(handled, alone)
         if not full:
             return lo
-        rungs = []
-        for r, name in enumerate(full):
-            cats = [name] * len(test)
-            for o in train:
-                h = [n for n in handled if n != o.name]
-                a = [n for n in alone if n != o.name]
-                loo = self.ladder(h, a) if h else full
-                cats.append(loo[r] if r < len(loo) else (loo[-1] if loo else name))
-            rungs.append(self.log_odds(list(test) + list(train), intent, cats))
+        loo = []  # per training object, its ladder named without it (a shorter one repeats its last rung)
+        for o in train:
+            h = [n for n in handled if n != o.name]
+            own = (self.ladder(h, [n for n in alone if n != o.name]) if h else full) or full
+            loo.append([own[min(r, len(own) - 1)] for r in range(len(full))])
+        rungs = [self.log_odds(list(test) + list(train), intent, [name] * len(test) + [lad[r] for lad in loo])
+                 for r, name in enumerate(full)]
         details["ladder"] = {"categories": list(full), "goal": lo.tolist(),
                              "terms": [{"test": v[: len(test)].tolist(), "train": v[len(test):].tolist()}
                                        for v in rungs]}
