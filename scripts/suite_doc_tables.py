@@ -15,6 +15,8 @@ PAPER_OMEGA = {"water_sensitive": "ω1", "paper_based": "ω2", "art_supplies": "
                "valuables": "ω4a", "electronics": "ω4b"}
 DEV_LABEL = {"cloth_items": "d1a", "breakables": "d1b", "leather_goods": "d2a", "wooden_items": "d2b",
              "toiletries": "d3a", "sewing_supplies": "d3b", "baking_tools": "d4a", "gardening_supplies": "d4b"}
+DEV2_LABEL = {"musical_instruments": "e1a", "houseplants": "e1b", "metal_things": "e2a", "toys": "e2b",
+              "dog_things": "e3a", "fishing_tackle": "e3b", "hair_accessories": "e4a", "candles": "e4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -50,15 +52,29 @@ def put(doc: str, name: str, body: str) -> str:
     return pattern.sub(lambda m: m.group(1) + body.rstrip("\n") + "\n" + m.group(2), doc, count=1)
 
 
+def catalog_size(doc: str, name: str, n: int) -> str:
+    """Set "its catalog holds N objects" in the section of suite ``name`` only."""
+    head = f"## The `{name}` suite\n"
+    if head not in doc:
+        raise SystemExit(f"docs/suites.md has no section {head.strip()!r}")
+    before, rest = doc.split(head, 1)
+    section, sep, after = rest.partition("\n## ")
+    section = re.sub(r"its catalog holds\s+\d+ objects", lambda m: re.sub(r"\d+", str(n), m.group(0)), section)
+    return before + head + section + sep + after
+
+
 def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
-    paper, dev = gift.load_suite("gift-paper"), gift.load_suite("gift-dev")
+    paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
     doc = put(doc, "gift-dev:intents", intent_tables(dev, DEV_LABEL))
+    doc = put(doc, "gift-dev2:summary", summary(dev2, DEV2_LABEL, "label"))
+    doc = put(doc, "gift-dev2:intents", intent_tables(dev2, DEV2_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
-    doc = re.sub(r"its catalog holds \d+ objects", f"its catalog holds {len(dev.objects)} objects", doc)
+    doc = catalog_size(doc, "gift-dev", len(dev.objects))
+    doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

@@ -1,12 +1,15 @@
-"""The shipped ``gift-dev`` suite: new intents and objects, none borrowed from the suites it is checked against.
+"""The shipped development suites ``gift-dev`` and ``gift-dev2``: new intents and objects, none borrowed from
+the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
-document's tables); they also check by name that nothing is shared with ``gift-paper`` or the LM test
-suite. Placement on the robots is checked in ``tests/experiments/test_scene_placement.py``.
+document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
+suite or the other development suite. Placement on the robots is checked in
+``tests/experiments/test_scene_placement.py``.
 """
 
 from __future__ import annotations
 
+import functools
 import itertools
 import re
 from pathlib import Path
@@ -20,33 +23,65 @@ from gift.core.suite import CONFOUNDS
 from gift.plugins.manager import get_manager
 
 ROOT = Path(__file__).resolve().parents[2]
-SUITE = "gift-dev"
-OTHER_SUITES = ("gift-paper", str(ROOT / "tests" / "kernels" / "data" / "lm_dev_suite.yaml"))
+LM_DEV = str(ROOT / "tests" / "kernels" / "data" / "lm_dev_suite.yaml")
 FAMILIES = {"place_mug", "sweep_spill", "pack_backpack", "store_drawer"}
-SIBLINGS = [("cloth_items", "breakables"), ("leather_goods", "wooden_items"), ("toiletries", "sewing_supplies"),
-            ("baking_tools", "gardening_supplies")]
-#: Goal patterns of the other suites (gift-paper and lm-dev), which no gift-dev goal may repeat.
-FOREIGN_GOALS = re.compile(r"art|read|valuab|electron|paper|water|sharp|picnic|food|first aid|medic",
-                           re.IGNORECASE)
-#: The gift-dev goals' own words, which would hand a description-reading kernel the labels.
-LABEL_WORDS = re.compile(r"fabric|cloth|textile|fragil|breakab|leather|\bwood|toiletr|sewing|baking|garden",
-                         re.IGNORECASE)
+#: Goal patterns of gift-paper and lm-dev, which no development goal may repeat.
+PAPER_AND_LM_GOALS = r"art|read|valuab|electron|paper|water|sharp|picnic|food|first aid|medic"
+#: Per development suite: its sibling intents and its goals' own words, which would hand a description-reading
+#: kernel the labels (no description of the suite may use them, and no goal of the other suites may name them).
+DEV_SUITES = {
+    "gift-dev": {
+        "siblings": [("cloth_items", "breakables"), ("leather_goods", "wooden_items"),
+                     ("toiletries", "sewing_supplies"), ("baking_tools", "gardening_supplies")],
+        "label_words": r"fabric|cloth|textile|fragil|breakab|leather|\bwood|toiletr|sewing|baking|garden",
+    },
+    "gift-dev2": {
+        "siblings": [("musical_instruments", "houseplants"), ("metal_things", "toys"),
+                     ("dog_things", "fishing_tackle"), ("hair_accessories", "candles")],
+        "label_words": r"instrument|music|plant|metal|\btoy|plaything|\bdog|canine|puppy|fish|tackle"
+                       r"|\bangl(?:er|ing)|accessor|candle",
+    },
+}
 DOC = ROOT / "docs" / "suites.md"
 
 
-@pytest.fixture(scope="module")
-def suite():
-    return gift.load_suite(SUITE)
+def label_words(name: str) -> re.Pattern:
+    return re.compile(DEV_SUITES[name]["label_words"], re.IGNORECASE)
+
+
+def foreign_goals(name: str) -> re.Pattern:
+    """Goal words of every other suite: gift-paper, lm-dev and the other development suites."""
+    others = [DEV_SUITES[n]["label_words"] for n in DEV_SUITES if n != name]
+    return re.compile("|".join([PAPER_AND_LM_GOALS, *others]), re.IGNORECASE)
+
+
+def other_suites(name: str) -> tuple[str, ...]:
+    return ("gift-paper", LM_DEV, *(n for n in DEV_SUITES if n != name))
+
+
+@functools.cache
+def load(name: str):
+    return gift.load_suite(name)
+
+
+INTENTS = [(name, i) for name, cfg in DEV_SUITES.items() for pair in cfg["siblings"] for i in pair]
+SIBLINGS = [(name, a, b) for name, cfg in DEV_SUITES.items() for a, b in cfg["siblings"]]
+
+
+@pytest.fixture(scope="module", params=list(DEV_SUITES))
+def suite(request):
+    return load(request.param)
 
 
 @pytest.fixture(scope="module")
-def others():
-    return [gift.load_suite(s) for s in OTHER_SUITES]
+def others(suite):
+    return [load(s) for s in other_suites(suite.name)]
 
 
 def test_loads_by_name_with_eight_intents_over_the_four_families(suite):
-    assert SUITE in get_manager().suites() and Path(suite.path).name == "gift-dev.yaml"
-    assert len(suite.intents) >= 6
+    assert suite.name in get_manager().suites() and Path(suite.path).name == f"{suite.name}.yaml"
+    assert len(suite.intents) == 8
+    assert {i for pair in DEV_SUITES[suite.name]["siblings"] for i in pair} == {i.id for i in suite.intents}
     assert {i.task for i in suite.intents} == FAMILIES
     for i in suite.intents:
         assert i.notes.strip(), f"{i.id}: the label rule belongs in notes"
@@ -60,8 +95,9 @@ def test_no_object_and_no_goal_is_shared_with_the_other_suites(suite, others):
         assert not shared_slugs, f"feature names shared with {other.name}: {sorted(shared_slugs)}"
         assert not {i.text for i in suite.intents} & {i.text for i in other.intents}
         assert not {i.id for i in suite.intents} & {i.id for i in other.intents}
+    foreign = foreign_goals(suite.name)
     for i in suite.intents:
-        assert not FOREIGN_GOALS.search(i.text) and not FOREIGN_GOALS.search(i.id), f"{i.id}: {i.text!r}"
+        assert not foreign.search(i.text) and not foreign.search(i.id), f"{i.id}: {i.text!r}"
 
 
 def test_goals_are_phrased_as_avoidance_and_sweeping(suite):
@@ -71,9 +107,9 @@ def test_goals_are_phrased_as_avoidance_and_sweeping(suite):
     assert sweep and all(t.startswith("sweep ") for t in sweep), sweep
 
 
-@pytest.mark.parametrize("intent_id", [i for pair in SIBLINGS for i in pair])
-def test_split_sizes(suite, intent_id):
-    i = suite.intent(intent_id)
+@pytest.mark.parametrize("suite_name,intent_id", INTENTS)
+def test_split_sizes(suite_name, intent_id):
+    i = load(suite_name).intent(intent_id)
     assert 5 <= len(i.train_objects) <= 6 and 2 <= len(i.relevant_train) <= 3
     assert 12 <= len(i.test) <= 16
     assert 0.4 <= len(i.relevant_test) / len(i.test) <= 0.6, "about half the test objects are relevant"
@@ -82,8 +118,9 @@ def test_split_sizes(suite, intent_id):
     assert any(t.relevant for t in s_r) and any(not t.relevant for t in s_r)
 
 
-@pytest.mark.parametrize("intent_id", [i for pair in SIBLINGS for i in pair])
-def test_every_confound_subset_is_present_and_real(suite, intent_id):
+@pytest.mark.parametrize("suite_name,intent_id", INTENTS)
+def test_every_confound_subset_is_present_and_real(suite_name, intent_id):
+    suite = load(suite_name)
     i = suite.intent(intent_id)
     lab = labels(i)
     goal_words = set(re.findall(r"[a-z]+", i.text.lower()))
@@ -100,9 +137,9 @@ def test_every_confound_subset_is_present_and_real(suite, intent_id):
     assert all(t.relevant for t in i.subset("unk")), "S_unk holds members whose membership is indirect"
 
 
-@pytest.mark.parametrize("a,b", SIBLINGS)
-def test_sibling_intents_share_training_objects_but_not_relevance(suite, a, b):
-    ia, ib = suite.intent(a), suite.intent(b)
+@pytest.mark.parametrize("suite_name,a,b", SIBLINGS)
+def test_sibling_intents_share_training_objects_but_not_relevance(suite_name, a, b):
+    ia, ib = load(suite_name).intent(a), load(suite_name).intent(b)
     assert ia.task == ib.task and ia.train_objects == ib.train_objects
     assert not set(ia.relevant_train) & set(ib.relevant_train)
 
@@ -112,10 +149,11 @@ def test_catalog_descriptions_and_appearances(suite):
     for i in suite.intents:
         used |= set(i.train_objects) | set(i.test_objects)
     assert used == set(suite.objects), f"unused catalog objects: {sorted(set(suite.objects) - used)}"
+    words = label_words(suite.name)
     for name, spec in suite.objects.items():
         d = spec.description
         assert d.strip() and "\n" not in d and len(d) <= 160, f"{name}: {d!r}"
-        assert not LABEL_WORDS.search(d), f"{name}: description gives a label away: {d!r}"
+        assert not words.search(d), f"{name}: description gives a label away: {d!r}"
         assert extent(spec.appearance) <= MAX_EXTENT_M, f"{name} is {extent(spec.appearance)} m across"
     for (a, sa), (b, sb) in itertools.combinations(suite.objects.items(), 2):
         assert sa.appearance != sb.appearance, f"{a} and {b} have identical appearances"
@@ -127,7 +165,7 @@ def test_catalog_descriptions_and_appearances(suite):
 
 def test_doc_tables_match_the_suite(suite):
     """docs/suites.md shows every label and subset of the file (regenerate: scripts/suite_doc_tables.py)."""
-    text = DOC.read_text(encoding="utf-8").split("## The `gift-dev` suite", 1)[1].split("\n## ", 1)[0]
+    text = DOC.read_text(encoding="utf-8").split(f"## The `{suite.name}` suite\n", 1)[1].split("\n## ", 1)[0]
     assert f"its catalog holds {len(suite.objects)} objects" in text.replace("\n", " ")
     for i in suite.intents:
         section = text.split(f"#### `{i.id}`", 1)[1].split("\n#### ", 1)[0]
