@@ -285,11 +285,12 @@ class GiftProbKernel(RelevanceKernel):
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
     the goal and the demonstrated training objects when ``relevant_train`` is given; ``"goal"``: from the
     goal alone), ``cut_prior`` (weight of the scores' own boundary 1/2 against the leave-one-out cut in the
-    train-calibrated threshold; 0: the leave-one-out cut alone), ``ladder`` (``"inferred"``: for an intent
-    inferred from demonstrations, also name three categories, narrow to broad, from the demonstrated objects
-    alone and average the z-scored log-odds under all four; the scene under each category alone is reported
-    as an intent candidate that answers can pick, see :mod:`gift.core.queries`; ``"always"``; ``"never"``, the
-    default: on the development suites it ranks better but cuts no better, docs/results/front_half.md).
+    train-calibrated threshold; 0: the leave-one-out cut alone; default 1, the boundary alone), ``ladder``
+    (``"inferred"``, the default: for an intent inferred from demonstrations, also name three categories,
+    narrow to broad, from the demonstrated objects alone and average the z-scored log-odds under all four;
+    the scene under each category alone is reported as an intent candidate that answers can pick, see
+    :mod:`gift.core.queries`; ``"always"``; ``"never"``, the default with a ``calibration``). Both defaults
+    were chosen on the three development suites, docs/results/front_half.md.
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -300,8 +301,8 @@ class GiftProbKernel(RelevanceKernel):
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
-                 select: str = "first", calibration: str = "none", cut_prior: float = 0.5,
-                 ladder: str = "never") -> None:
+                 select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
+                 ladder: str | None = None) -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -321,6 +322,8 @@ class GiftProbKernel(RelevanceKernel):
         if select not in SELECT:
             raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
         self.select = select
+        if ladder is None:  # the ladder's averaged z-scores are not what a calibration was fitted on
+            ladder = "inferred" if calibration == "none" else "never"
         if ladder not in LADDER:
             raise GiftError(f"gift-prob: ladder must be one of {LADDER}, got {ladder!r}")
         if ladder != "never" and calibration != "none":
@@ -329,14 +332,18 @@ class GiftProbKernel(RelevanceKernel):
         #: When to add the category ladder (:meth:`ladder`): three names, narrow to broad, of what the
         #: demonstrated training objects share, asked without the goal; the LM term becomes the mean of the
         #: z-scored log-odds under the goal's category and each rung. ``"inferred"``: only for an intent
-        #: inferred from demonstrations (whose goal text the small model wrote); ``"always"``; ``"never"``.
+        #: inferred from demonstrations (whose goal text the small model wrote; the default, chosen on gift-dev,
+        #: gift-dev2 and lm-dev: mean train-calibrated F1 0.764 -> 0.808 with cut_prior=1); ``"always"``;
+        #: ``"never"`` (the default with a calibration).
         self.ladder_mode = ladder
         self._ladder_memo: dict[tuple, tuple[str, ...]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
             raise GiftError(f"gift-prob: cut_prior must be in [0, 1], got {cut_prior!r}")
         #: Weight of the scale's own boundary, 1/2 (the scene's mean combined z-score; for ``combine="none"``
         #: P(yes) = P(no)), against the leave-one-out cut in the train-calibrated threshold (0: that cut
-        #: alone). 1/2 chosen on gift-dev and lm-dev (docs/results/front_half.md).
+        #: alone; 1: the boundary alone, the default). Chosen with the ladder on gift-dev, gift-dev2 and lm-dev:
+        #: 3-6 training objects place a cut more noisily than the scale's own boundary
+        #: (docs/results/front_half.md, section 10).
         self.cut_prior = float(cut_prior)
         #: ``"none"``: z-scores per intent with reliability weights, the cut placed on the training scores;
         #: ``"pooled"``: the shipped :class:`~gift_kernels.calibration.TermCalibration`, updated per intent with
