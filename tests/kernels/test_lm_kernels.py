@@ -319,7 +319,8 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
 
 
 def test_gift_prob_gives_the_prior_cut_one_half_with_the_weight_cut_prior():
-    """The train-calibrated cut of gift-prob: the leave-one-out cut averaged with 1/2 (cut_prior: its weight)."""
+    """The train-calibrated cut of gift-prob: the leave-one-out cut averaged with 1/2 (cut_prior: its weight;
+    by default 1, the scale's boundary alone)."""
     from gift.core.alignment import best_separating_cut, score_alignment
 
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
@@ -333,14 +334,15 @@ def test_gift_prob_gives_the_prior_cut_one_half_with_the_weight_cut_prior():
                                                                  need=("train-calibrated",))
 
     rs, al = scores()
-    assert rs.prior_cut == 0.5 and rs.prior_weight == 0.5 and al.prior_cut == 0.5
+    assert rs.prior_cut == 0.5 and rs.prior_weight == 1.0 and al.prior_cut == 0.5
+    assert al.threshold("train-calibrated")[0] == pytest.approx(0.5)
     loo = best_separating_cut([0.9, 0.8], [0.2, 0.1])
+    rs, al = scores(cut_prior=0.5)
     cut, note = al.threshold("train-calibrated")
     assert cut == pytest.approx(0.5 * 0.5 + 0.5 * loo) and "prior cut 0.5 (weight 0.5)" in note
     rs0, al0 = scores(cut_prior=0.0)
     assert rs0.prior_cut is None and al0.threshold("train-calibrated") == (pytest.approx(loo), pytest.approx(
         "leave-one-out over 2 relevant / 2 other training objects"))
-    assert scores(cut_prior=1.0)[1].threshold("train-calibrated")[0] == pytest.approx(0.5)
     with pytest.raises(GiftError, match="gift-prob: cut_prior must be in"):
         GiftProbKernel(cut_prior=1.5)
 
@@ -413,8 +415,8 @@ def test_gift_prob_on_the_embedded_model_recovers_the_category_of_an_object_boun
     intent = Intent(text="sweep the leather belt away from the spill", source="inferred")
     auc, cats = {}, {}
     for source in ("goal", "goal+objects"):
-        rs = GiftProbKernel(lm=embedded_lm, category_from=source, combine="none").score(
-            test, train, intent, spec.relevant_train)
+        rs = GiftProbKernel(lm=embedded_lm, category_from=source, combine="none", ladder="never").score(
+            test, train, intent, spec.relevant_train)  # the goal's category alone, without the ladder
         auc[source], cats[source] = roc_auc(rs.relevance, labels), rs.details["category"].lower()
     assert "leather" in cats["goal+objects"] and "belt" not in cats["goal+objects"], cats
     assert auc["goal+objects"] >= 0.9 and auc["goal+objects"] >= auc["goal"], (auc, cats)
@@ -436,8 +438,9 @@ def test_gift_prob_ladder_on_the_embedded_model_names_the_class_a_generic_inferr
     labels = [t.relevant for t in spec.test]
     intent = Intent(text="The person wanted to carry the mug to the goal spot as quickly as possible.",
                     source="inferred")
-    plain = GiftProbKernel(lm=embedded_lm, combine="none").score(test, train, intent, spec.relevant_train)
-    k = GiftProbKernel(lm=embedded_lm, ladder="inferred")
+    plain = GiftProbKernel(lm=embedded_lm, combine="none", ladder="never").score(test, train, intent,
+                                                                               spec.relevant_train)
+    k = GiftProbKernel(lm=embedded_lm)  # the default: the ladder for an inferred intent
     sc = score_alignment(k, test, train, intent, relevant_train=spec.relevant_train)
     rungs = [c.lower() for c in sc.details["ladder"]["categories"]]
     assert 2 <= len(rungs) <= 3 and not any(o in c for c in rungs for o in ("laptop", "phone")), rungs
@@ -562,6 +565,8 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
         GiftProbKernel(ladder="sometimes")
     with pytest.raises(GiftError, match="calibration"):
         GiftProbKernel(ladder="inferred", calibration="pooled")
+    # the default: the ladder for inferred intents, none with a calibration (fitted on one category's log-odds)
+    assert GiftProbKernel().ladder_mode == "inferred" and GiftProbKernel(calibration="pooled").ladder_mode == "never"
     with pytest.raises(ValueError, match="handled object"):
         prompts.ladder_messages([], ["banana"])
 
