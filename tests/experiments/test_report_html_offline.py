@@ -56,6 +56,26 @@ def test_partial_results_and_intent_candidates(tmp_path):
     assert page.count('class="object-row"') == len(gift.load_suite("gift-paper").intent("valuables").test)
 
 
+def test_the_category_and_the_ladder_gift_prob_asked_about_are_shown(tmp_path):
+    """gift-prob's details (the goal's category, the ladder's rungs, the term weights) reach the intent's
+    section; a kernel without them adds nothing."""
+    block = {"cut": 0.5, "note": "boundary", "mapping": {}, "scores": {}}
+    details = {"category": "necklaces", "ladder": {"categories": ["diamond jewelry", "pearl jewelry",
+                                                                  "things for decoration"]},
+               "weights": {"lm": 0.43, "language": 0.57}}
+    results = {"config": {"suite": "gift-paper", "robot": "jaco", "thresholds": ["train-calibrated"]},
+               "intents": {"valuables": {"text": "store the pearl necklace", "source": "inferred"}},
+               "alignment": {"valuables": {"gift-prob": {"thresholds": {"train-calibrated": block},
+                                                         "details": details},
+                                           "language": {"thresholds": {"train-calibrated": block}}}}}
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert 'class="section-error"' not in page
+    assert page.count('class="kernel-category"') == 1
+    assert "one of the <q>necklaces</q>" in page
+    assert "<q>diamond jewelry</q> &rarr; <q>pearl jewelry</q> &rarr; <q>things for decoration</q>" in page
+    assert "lm 0.43, language 0.57" in page
+
+
 def test_a_broken_section_is_reported_and_the_rest_is_written(tmp_path):
     results = {"config": {"thresholds": ["oracle"]}, "rq1": {"x": {"vision": {"mean": "not a number"}}},
                "timing": {"total": 3.0}}

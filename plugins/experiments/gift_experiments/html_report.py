@@ -275,8 +275,8 @@ class Report:
 
     # ------------------------------------------------------------------ one intent
     def intent(self, intent: str) -> str:
-        parts = [self._intent_text(intent), self._intent_scores(intent), self._objects(intent),
-                 self._similarity(intent)]
+        parts = [self._intent_text(intent), self._kernel_categories(intent), self._intent_scores(intent),
+                 self._objects(intent), self._similarity(intent)]
         views = [v for v in self.views if v.get("intent") == intent and v.get("file")]
         if views:
             parts.append("<p>Replays in Meshcat: " + ", ".join(
@@ -342,6 +342,27 @@ class Report:
                            if isinstance(a, Mapping) and a.get("objects") else "") + "</li>" for a in axes) + "</ul>"
                 out.append(f"<details><summary>motivations and axes the LM gave</summary>{det}</details>")
         return "".join(out)
+
+    def _kernel_categories(self, intent: str) -> str:
+        """What a category-asking kernel (``gift-prob``) asked about: the goal's category, the ladder's
+        rungs named from the demonstrated objects, and its terms' weights (from its ``details``)."""
+        rows = []
+        for kernel, by_th in load_alignments(self.r, self.out, intent).items():
+            det = next((b.get("details") for b in by_th.values() if isinstance(b, Mapping) and b.get("details")), None)
+            if not isinstance(det, Mapping) or not (det.get("category") or det.get("ladder")):
+                continue
+            text = f"<b>{esc(kernel)}</b> asked whether each object is one of the <q>{esc(det.get('category', ''))}</q>"
+            ladder = det.get("ladder")
+            if isinstance(ladder, Mapping) and ladder.get("categories"):
+                rungs = " &rarr; ".join(f"<q>{esc(c)}</q>" for c in ladder["categories"])
+                text += (f", and of three categories named from the demonstrated objects alone, narrow to broad: "
+                         f"{rungs} (its LM term averages the four)")
+            weights = det.get("weights")
+            if isinstance(weights, Mapping) and weights:
+                text += " <small>(term weights: " + ", ".join(
+                    f"{esc(k)} {_num(v, 2)}" for k, v in weights.items() if isinstance(v, (int, float))) + ")</small>"
+            rows.append(f'<p class="kernel-category">{text}.</p>')
+        return "".join(rows)
 
     def _intent_scores(self, intent: str) -> str:
         rq1 = (self.r.get("rq1") or {}).get(intent) or {}
