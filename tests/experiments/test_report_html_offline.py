@@ -17,7 +17,7 @@ from gift_experiments.html_report import write_html_report
 from gift_experiments.report import place_labels
 
 ROOT = Path(__file__).resolve().parents[2]
-DEMO = ROOT / "docs" / "results" / "demo"
+DEMO = Path(__file__).parent / "data" / "demo_before_alignments"  # gift demo at commit b13a016
 FRANKA = ROOT / "docs" / "results" / "reproduce" / "franka" / "results.json"
 
 
