@@ -275,8 +275,9 @@ class Report:
 
     # ------------------------------------------------------------------ one intent
     def intent(self, intent: str) -> str:
-        parts = [self._intent_text(intent), self._kernel_categories(intent), self._intent_scores(intent),
-                 self._objects(intent), self._similarity(intent)]
+        al = load_alignments(self.r, self.out, intent)  # read once: four sections use it
+        parts = [self._intent_text(intent), self._kernel_categories(al), self._intent_scores(intent, al),
+                 self._objects(intent, al), self._similarity(intent, al)]
         views = [v for v in self.views if v.get("intent") == intent and v.get("file")]
         if views:
             parts.append("<p>Replays in Meshcat: " + ", ".join(
@@ -343,20 +344,22 @@ class Report:
                 out.append(f"<details><summary>motivations and axes the LM gave</summary>{det}</details>")
         return "".join(out)
 
-    def _kernel_categories(self, intent: str) -> str:
+    @staticmethod
+    def _kernel_categories(al: Mapping[str, Any]) -> str:
         """What a category-asking kernel (``gift-prob``) asked about: the goal's category, the ladder's
         rungs named from the demonstrated objects, and its terms' weights (from its ``details``)."""
         rows = []
-        for kernel, by_th in load_alignments(self.r, self.out, intent).items():
+        for kernel, by_th in al.items():
             det = next((b.get("details") for b in by_th.values() if isinstance(b, Mapping) and b.get("details")), None)
             if not isinstance(det, Mapping) or not (det.get("category") or det.get("ladder")):
                 continue
             text = f"<b>{esc(kernel)}</b> asked whether each object is one of the <q>{esc(det.get('category', ''))}</q>"
             ladder = det.get("ladder")
             if isinstance(ladder, Mapping) and ladder.get("categories"):
+                n = len(ladder["categories"])
                 rungs = " &rarr; ".join(f"<q>{esc(c)}</q>" for c in ladder["categories"])
-                text += (f", and of three categories named from the demonstrated objects alone, narrow to broad: "
-                         f"{rungs} (its LM term averages the four)")
+                text += (f", and of {n} categor{'y' if n == 1 else 'ies'} named from the demonstrated objects "
+                         f"alone, narrow to broad: {rungs} (its LM term averages all {n + 1})")
             weights = det.get("weights")
             if isinstance(weights, Mapping) and weights:
                 text += " <small>(term weights: " + ", ".join(
@@ -364,10 +367,9 @@ class Report:
             rows.append(f'<p class="kernel-category">{text}.</p>')
         return "".join(rows)
 
-    def _intent_scores(self, intent: str) -> str:
+    def _intent_scores(self, intent: str, al: Mapping[str, Any]) -> str:
         rq1 = (self.r.get("rq1") or {}).get(intent) or {}
         rq2 = (self.r.get("rq2") or {}).get(intent) or {}
-        al = load_alignments(self.r, self.out, intent)
         kernels = _kernels({"x": {**rq2, **rq1}})
         if not kernels:
             return _missing("No scores for this intent.")
@@ -400,8 +402,7 @@ class Report:
                     names.setdefault(n, None)
         return [(n, rel, ()) for n, rel in names.items()]
 
-    def _objects(self, intent: str) -> str:
-        al = load_alignments(self.r, self.out, intent)
+    def _objects(self, intent: str, al: Mapping[str, Any]) -> str:
         objects = self._object_list(intent, al)
         if not objects:
             return _missing("No test objects recorded for this intent.")
@@ -458,9 +459,8 @@ class Report:
         return (f'<div{cls} title="{esc(kind)} {_num(score)}, cut {_num(block.get("cut"))}">'
                 f"<span class=\"score\">{_num(score)}</span> {what}{extra}</div>")
 
-    def _similarity(self, intent: str) -> str:
+    def _similarity(self, intent: str, al: Mapping[str, Any]) -> str:
         out = []
-        al = load_alignments(self.r, self.out, intent)
         objects = {n: rel for n, rel, _ in self._object_list(intent, al)}
         rows = []
         for k in _kernels({"x": al}):
