@@ -78,9 +78,14 @@ def run(args: argparse.Namespace) -> dict:
                          f" ({d.note})" if d.note else "")
             if not data:
                 continue
-            sim = qc.simulate(data, random_seeds=args.random_seeds)
-            # the first cut rule tried (widest gap), for the record
-            sim["widest"] = qc.simulate(data, random_seeds=args.random_seeds, bands=(), move="widest")["curves"]
+            sim = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid, policies=args.policies,
+                              rescore=args.rescore)
+            if args.rescore:  # the same sessions with answers that only re-threshold, for the comparison
+                sim["without_rescore"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
+                                                     policies=args.policies, bands=())["curves"]
+            else:  # the first cut rule tried (widest gap), for the record
+                sim["widest"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
+                                            policies=args.policies, bands=(), move="widest")["curves"]
             sim.update({"suite": suite.name, "intent_source": source, "robot": args.robot, "kernel": args.kernel,
                         "config": attrs.asdict(cfg), "target": qc.target_check(sim),
                         "intents": {d.intent: {"intent_text": d.intent_text, "relevant": list(d.relevant),
@@ -90,6 +95,7 @@ def run(args: argparse.Namespace) -> dict:
             out["runs"][f"{suite.name} | {source}"] = sim
     out["lm"] = lm_inputs(comp) if comp is not None and comp.lm_built else None
     out["random_seeds"] = args.random_seeds
+    out["rescore"] = bool(args.rescore)
     out["seconds"] = round(time.perf_counter() - t_all, 1)
     return out
 
@@ -139,7 +145,11 @@ def write(result: dict, md: Path) -> None:
              "seeds (± 1 standard error over seeds in the tables and the figure).", "",
              "!!! note \"Which recipe\"",
              f"    {recipe} Inferred intents: the relevant training objects and the intent "
-             "come from the demonstrations alone.", "",
+             "come from the demonstrations alone." + (
+                 " **Answers re-score the scene** (rule 5 of `gift.core.queries`, `--rescore`): after each answer "
+                 "the kernel scores the scene again with the answers as evidence (`gift-prob` names its category "
+                 "ladder again); each suite's table also gives the same sessions without it."
+                 if result.get("rescore") else ""), "",
              "Command:", "", "```", result["command"], "```", "",
              f"Commit `{(git.get('commit') or '?')[:10]}`{' (dirty)' if git.get('dirty') else ''}, code version "
              f"`{result.get('code_version', '?')[:12]}`, LM `{lm.get('identity', '–')}` (model sha256 "
@@ -202,11 +212,20 @@ def write(result: dict, md: Path) -> None:
                 lines.append(f"| {row['k']} | {_fmt(row['f1'])} | "
                              f"{'more than ' + str(grid[-1]) if row['random_needs'] is None else _fmt(row['random_needs'], 1)} | "
                              f"{'–' if row['ratio'] is None else _fmt(row['ratio'], 2)} |")
-            lines += ["", "The first cut rule tried, the widest-gap midpoint of the evidence (`move=\"widest\"`, "
-                      "dropped, see `gift.core.queries`), pooled F1 after k questions:", "",
-                      "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
-            for policy in qc.POLICIES + (qc.BASELINE,):
-                lines.append(f"| {policy} | " + " | ".join(_fmt(v) for v in r["widest"][policy]["f1"]) + " |")
+            if "widest" in r:
+                lines += ["", "The first cut rule tried, the widest-gap midpoint of the evidence (`move=\"widest\"`, "
+                          "dropped, see `gift.core.queries`), pooled F1 after k questions:", "",
+                          "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
+                for policy in qc.POLICIES + (qc.BASELINE,):
+                    lines.append(f"| {policy} | " + " | ".join(_fmt(v) for v in r["widest"][policy]["f1"]) + " |")
+            if "without_rescore" in r:
+                lines += ["", "The same sessions with answers that only re-threshold the first scores (no re-scoring, "
+                          "rule 5 off), pooled F1 / mean win rate after k questions:", "",
+                          "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
+                for policy in qc.POLICIES + (qc.BASELINE,):
+                    c = r["without_rescore"][policy]
+                    lines.append(f"| {policy} | " + " | ".join(f"{_fmt(c['f1'][j])} / {_fmt(c['win'][j])}"
+                                                             for j in range(len(grid))) + " |")
             lines += ["", "Abstention at k = 0 (objects within the band of the cut are flagged and dropped like "
                       "distractors; F1 counts them as not aligned, *F1 decided* leaves them out):", "",
                       "| band | flagged objects | F1 (pooled) | F1 decided (mean over intents) | win rate |",
@@ -243,6 +262,12 @@ def write(result: dict, md: Path) -> None:
     md.write_text("\n".join(lines), encoding="utf-8")
 
 
+def qc_grid() -> tuple[int, ...]:
+    from gift_experiments.query_curves import K_GRID
+
+    return K_GRID
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--suites", default=",".join(DEFAULT_SUITES))
@@ -253,7 +278,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--random-seeds", type=int, default=10)
     p.add_argument("--stages", default="out/query_curves", help="stage cache directory (kernel scores, intents)")
     p.add_argument("--out", default="docs/results/queries.md")
+    p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
+    p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
+    p.add_argument("--rescore", action="store_true",
+                   help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "
+                        "the curves without it are kept next to them")
     args = p.parse_args(argv)
+    args.grid = tuple(int(k) for k in args.grid.split(","))
+    args.policies = tuple(s.strip() for s in args.policies.split(",") if s.strip())
+    if 2 not in args.grid or 0 not in args.grid:
+        p.error("--grid must include 0 and 2")
     args.suites = [s.strip() for s in args.suites.split(",") if s.strip()]
     args.intent_sources = [s.strip() for s in args.intent_sources.split(",") if s.strip()]
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s", datefmt="%H:%M:%S")

@@ -66,7 +66,7 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec, Intent, ObjectSpec
+from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, FeatureSpec, Intent, ObjectSpec, RelevanceScores
 from gift.core.errors import GiftError
 from gift.core.interfaces import AlignmentOperator, RelevanceKernel, SimilarityKernel
 from gift.core.metrics import binary_metrics
@@ -400,17 +400,7 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
     n_fallbacks = len(getattr(kernel, "fallbacks", ()))
     if isinstance(kernel, RelevanceKernel):
         rs = kernel.score(test, train, intent, tuple(relevant_train))
-        decision = _check_vector(rs.relevance, len(test), kernel, "the test objects")
-        train_r = _check_vector(rs.train_loo, len(train), kernel, "the held-out training objects")
-        mask = np.asarray(rs.relevant, dtype=bool)
-        if mask.shape != (len(train),):
-            raise GiftError(f"kernel {kname!r}: RelevanceScores.relevant must be [{len(train)}] booleans")
-        fallbacks = tuple(getattr(kernel, "fallbacks", ()))[n_fallbacks:]
-        return _relevance_scores(tuple(o.name for o in test), tuple(names), tuple(relevant_train), kname, decision,
-                                 train_r, mask, want_train=want_train,
-                                 calibrated="train-calibrated" in need and bool(relevant_train),
-                                 details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut,
-                                 prior=(rs.prior_cut, rs.prior_weight))
+        return _from_relevance(kernel, rs, test, train, tuple(relevant_train), need, n_fallbacks)
     train_mean = loo_scores = loo_labels = None
     rows = test + train if want_train else test
     K_all = _check_matrix(kernel.similarity(rows, train, intent), len(rows), len(train), kernel,
@@ -428,6 +418,45 @@ def score_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train:
                            relevant_train=tuple(relevant_train), K=K, decision=decision, target=target,
                            aligned=aligned, kernel=kname, train_mean=train_mean, loo_scores=loo_scores,
                            loo_labels=loo_labels, fallbacks=fallbacks, relevant_mask=rel_mask)
+
+
+def rescore_alignment(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                      intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+                      answers: Mapping[str, bool], need: Sequence[str] = THRESHOLDS) -> AlignmentScores | None:
+    """The scene of :func:`score_alignment` scored again with the human's ``answers`` (test object name ->
+    part of the goal?) as evidence (:meth:`RelevanceKernel.score_with_answers`); None when the kernel cannot
+    use answers (a matrix kernel, or a relevance kernel that does not implement it)."""
+    test, train = tuple(test), tuple(train)
+    names = {o.name for o in test}
+    unknown = [a for a in answers if a not in names]
+    if unknown:
+        raise GiftError(f"answers about {unknown}, which are not test objects {sorted(names)}")
+    if not isinstance(kernel, RelevanceKernel) or not answers:
+        return None
+    n_fallbacks = len(getattr(kernel, "fallbacks", ()))
+    rs = kernel.score_with_answers(test, train, intent, tuple(relevant_train), dict(answers))
+    if rs is None:
+        return None
+    return _from_relevance(kernel, rs, test, train, tuple(relevant_train), set(need), n_fallbacks)
+
+
+def _from_relevance(kernel: SimilarityKernel, rs: RelevanceScores, test: tuple[ObjectSpec, ...],
+                    train: tuple[ObjectSpec, ...], relevant_train: tuple[str, ...], need: set[str] | Sequence[str],
+                    n_fallbacks: int) -> AlignmentScores:
+    """:class:`AlignmentScores` of one :class:`RelevanceScores` pass, its shapes checked."""
+    kname = getattr(kernel, "name", type(kernel).__name__)
+    decision = _check_vector(rs.relevance, len(test), kernel, "the test objects")
+    train_r = _check_vector(rs.train_loo, len(train), kernel, "the held-out training objects")
+    mask = np.asarray(rs.relevant, dtype=bool)
+    if mask.shape != (len(train),):
+        raise GiftError(f"kernel {kname!r}: RelevanceScores.relevant must be [{len(train)}] booleans")
+    fallbacks = tuple(getattr(kernel, "fallbacks", ()))[n_fallbacks:]
+    want_train = ("non-oracle" in need or "train-calibrated" in need) and len(train) > 1
+    return _relevance_scores(tuple(o.name for o in test), tuple(o.name for o in train), relevant_train, kname,
+                             decision, train_r, mask, want_train=want_train,
+                             calibrated="train-calibrated" in need and bool(relevant_train),
+                             details=dict(rs.details), fallbacks=fallbacks, natural_cut=rs.cut,
+                             prior=(rs.prior_cut, rs.prior_weight))
 
 
 def _relevance_scores(test: tuple[str, ...], train: tuple[str, ...], relevant_train: tuple[str, ...], kname: str,

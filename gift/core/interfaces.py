@@ -198,6 +198,17 @@ class RelevanceKernel(SimilarityKernel):
         from them, or given); empty: the kernel guesses them itself.
         """
 
+    def score_with_answers(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None,
+                           relevant_train: Sequence[str], answers: Mapping[str, bool]) -> RelevanceScores | None:
+        """The scene scored again with the human's ``answers`` (test object name -> part of the goal?) as
+        evidence next to the demonstrations, or None (the default) when the kernel cannot use answers: the
+        query loop then only re-thresholds the first scores (:mod:`gift.core.queries`, rule 5).
+
+        Called with one or more answers, each time the set of answers grows; the answered objects' own
+        decisions are fixed by the query loop whatever this returns.
+        """
+        return None
+
     def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                    intent: Intent | None = None) -> np.ndarray:
         """``[n_test, n_train]`` from one :meth:`score` pass (no relevant training objects given)."""

@@ -48,6 +48,14 @@ How answers update the scene (the rule)
    of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
    fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
    The chosen candidate's scores, re-thresholded by rule 2, decide the objects not answered.
+5. **A kernel that can use answers re-scores the scene with them.** When the problem has a ``rescore``
+   callable (:func:`kernel_rescorer`: the kernel implements
+   :meth:`~gift.core.interfaces.RelevanceKernel.score_with_answers`), each time the set of answers with a
+   "yes" or "no" grows the scene is scored again with them as evidence, and the re-scored scene and the
+   views it reports replace every candidate (then rules 3, 2 and 1 apply as above). ``gift-prob`` names its
+   category ladder again with the "yes" objects beside the demonstrated ones and the "no" objects beside
+   the left-alone ones. Re-scored scenes are kept per set of answers, and a policy's "what if" states
+   (:meth:`QueryState.assume`) re-threshold the current scores without re-scoring.
 4. **Abstention.** An object not answered (or answered "don't know") whose decision score lies strictly
    within ``abstain`` of the cut, ``|decision - cut| < abstain``, is *flagged* instead of decided: it is
    reported, and its semantic features are held out of scoring exactly as a distractor's are (its
@@ -291,7 +299,9 @@ class QueryProblem:
     for which ones answers move); ``trajectories``: the scene's test trajectories ``[N, T, F]`` (one
     batch per scene; empty: one state per object); ``lipschitz``: L of the error bound; ``abstain``: the
     abstention band on the decision scale (0: never abstain); ``test_labels``: only for the oracle cut;
-    ``move``: how answers move the train-calibrated cut (:data:`MOVES`, rule 2).
+    ``move``: how answers move the train-calibrated cut (:data:`MOVES`, rule 2); ``rescore``: ``answers
+    (object -> bool) -> AlignmentScores | None``, the scene scored again with the answers (rule 5;
+    :func:`kernel_rescorer`), None: answers only re-threshold.
     """
 
     candidates: Mapping[str, AlignmentScores] = attrs.field(converter=dict)
@@ -301,6 +311,8 @@ class QueryProblem:
     abstain: float = attrs.field(default=0.0, converter=float, validator=_check_band)
     test_labels: Mapping[str, bool] | None = None
     move: str = attrs.field(default="nearest", validator=_check_move)
+    rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = attrs.field(default=None, eq=False)
+    _rescored: dict = attrs.field(factory=dict, init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
         if not self.candidates:
@@ -322,7 +334,8 @@ class QueryProblem:
     def of(cls, scores: AlignmentScores, strategy: str | float = "train-calibrated", *,
            candidates: Mapping[str, AlignmentScores] | None = None, trajectories: Sequence[FeatureBatch] = (),
            lipschitz: float = 1.0, abstain: float = 0.0, test_labels: Mapping[str, bool] | None = None,
-           move: str = "nearest") -> "QueryProblem":
+           move: str = "nearest", rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = None
+           ) -> "QueryProblem":
         """The problem of one scene: ``scores`` (the kernel's own intent, named :data:`PRIMARY`), then
         ``candidates`` (other intents' scores of the same scene), then the candidates the kernel reported
         in ``scores.details["candidates"]``."""
@@ -331,7 +344,26 @@ class QueryProblem:
             if name in cands:
                 raise GiftError(f"two intent candidates are named {name!r}")
             cands[name] = s
-        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move)
+        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move, rescore)
+
+    def candidates_for(self, answers: Sequence[Answer]) -> Mapping[str, AlignmentScores]:
+        """The candidates that decide a scene with ``answers`` (rule 5): :attr:`candidates`, or, when the
+        problem can re-score and some answer is a "yes" or "no", the re-scored scene (as :data:`PRIMARY`)
+        and the views it reports (kept per set of answers)."""
+        known = tuple(sorted((a.object, bool(a.relevant)) for a in answers if a.relevant is not None))
+        if self.rescore is None or not known:
+            return self.candidates
+        if known not in self._rescored:
+            new = self.rescore(dict(known))
+            if new is None:
+                self._rescored[known] = self.candidates
+            else:
+                if not isinstance(new, AlignmentScores) or new.test != self.test:
+                    raise GiftError(f"re-scoring with answers {dict(known)} gave "
+                                    f"{type(new).__name__ if not isinstance(new, AlignmentScores) else list(new.test)}"
+                                    f", expected AlignmentScores of the test objects {list(self.test)}")
+                self._rescored[known] = {PRIMARY: new, **views_from_details(new, "candidates")}
+        return self._rescored[known]
 
     @property
     def test(self) -> tuple[str, ...]:
@@ -421,7 +453,8 @@ class QueryState:
     ``[n_test]``: the decision scores after the answers (``predicted == decision >= cut``: answered
     "yes" at ``max(1, cut)``, answered "no" and abstained objects at -1); ``abstained``: flagged
     objects; ``alignment``: f_ω after the answers and abstentions; ``mistakes``: per candidate, answered
-    objects its decisions had wrong.
+    objects its decisions had wrong; ``candidates``: the candidates' scores this state was decided from
+    (the problem's, or the scene re-scored with the answers, rule 5).
     """
 
     problem: QueryProblem
@@ -434,11 +467,18 @@ class QueryState:
     abstained: tuple[str, ...]
     alignment: Alignment
     mistakes: Mapping[str, int] = attrs.field(factory=dict)
+    candidates: Mapping[str, AlignmentScores] = attrs.field(factory=dict, eq=False)
 
     @property
     def scores(self) -> AlignmentScores:
-        """The chosen candidate's scores (as the kernel gave them, before the answers)."""
-        return self.problem.candidates[self.chosen]
+        """The chosen candidate's scores (as the kernel gave them, re-scored with the answers under rule 5,
+        before rules 1, 2 and 4)."""
+        return (self.candidates or self.problem.candidates)[self.chosen]
+
+    @property
+    def rescored(self) -> bool:
+        """Whether the scene was re-scored with the answers (rule 5)."""
+        return bool(self.candidates) and self.candidates is not self.problem.candidates
 
     @property
     def test(self) -> tuple[str, ...]:
@@ -454,8 +494,9 @@ class QueryState:
         return next((a for a in self.answers if a.object == name), None)
 
     def assume(self, answer: Answer) -> "QueryState":
-        """The state with one more answer (what a policy asks itself: what if the human said this?)."""
-        return resolve(self.problem, self.answers + (answer,))
+        """The state with one more answer (what a policy asks itself: what if the human said this?), decided
+        from this state's candidates: re-thresholded, not re-scored."""
+        return resolve(self.problem, self.answers + (answer,), candidates=self.candidates or None)
 
     def belief(self) -> np.ndarray:
         """``[n_test]`` P("yes"): 1 / 0 for answered objects, :func:`belief` of the chosen scores otherwise."""
@@ -470,7 +511,8 @@ class QueryState:
         several, else the terms the kernel reported (``details["terms"]``), else none. Each view is
         thresholded by the problem's strategy with the same answers (rule 2)."""
         p = self.problem
-        views = dict(p.candidates) if len(p.candidates) > 1 else views_from_details(self.scores, "terms")
+        cands = self.candidates or p.candidates
+        views = dict(cands) if len(cands) > 1 else views_from_details(self.scores, "terms")
         if len(views) < 2:
             return {}
         return {name: belief(s.decision, answered_cut(s, p.strategy, self.answers, p.test_labels, p.move)[0])
@@ -488,7 +530,8 @@ class QueryState:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able: the answers, the cut and its note, the chosen candidate, flagged objects, f_ω."""
-        return {"chosen": self.chosen, "candidates": list(self.problem.candidates), "mistakes": dict(self.mistakes),
+        return {"chosen": self.chosen, "candidates": list(self.candidates or self.problem.candidates),
+                "mistakes": dict(self.mistakes), "rescored": self.rescored,
                 "cut": self.cut, "note": self.note, "answers": [a.to_dict() for a in self.answers],
                 "asked": len(self.answers), "abstained": list(self.abstained), "n_abstained": len(self.abstained),
                 "mapping": dict(self.alignment.mapping), "scores": dict(self.alignment.scores),
@@ -503,8 +546,12 @@ def _one_state_per_object(test: Sequence[str]) -> FeatureBatch:
     return FeatureBatch(specs, np.eye(len(test))[None] if test else np.zeros((1, 0, 0)))
 
 
-def resolve(problem: QueryProblem, answers: Sequence[Answer] = ()) -> QueryState:
-    """Re-score the scene of ``problem`` with ``answers`` (the rules of the module docstring)."""
+def resolve(problem: QueryProblem, answers: Sequence[Answer] = (), *,
+            candidates: Mapping[str, AlignmentScores] | None = None) -> QueryState:
+    """Re-score the scene of ``problem`` with ``answers`` (the rules of the module docstring).
+
+    ``candidates``: decide from these scores instead of :meth:`QueryProblem.candidates_for` (no re-scoring;
+    what :meth:`QueryState.assume` passes)."""
     answers = tuple(answers)
     test = problem.test
     seen: set[str] = set()
@@ -517,14 +564,15 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = ()) -> QueryState
             raise GiftError(f"{a.object!r} was answered twice")
         seen.add(a.object)
     known = [a for a in answers if a.relevant is not None]
+    cands = problem.candidates_for(answers) if candidates is None else candidates  # rule 5
     # rule 3: the candidate whose own decisions got the fewest answered objects wrong (ties: the earlier)
     mistakes = {}
-    for name, s in problem.candidates.items():
+    for name, s in cands.items():
         cut0, _ = answered_cut(s, problem.strategy, (), problem.test_labels)
         mistakes[name] = sum(bool(s.decision[test.index(a.object)] >= cut0) != a.relevant for a in known)
-    order = list(problem.candidates)
+    order = list(cands)
     chosen = min(order, key=lambda n: (mistakes[n], order.index(n)))
-    scores = problem.candidates[chosen]
+    scores = cands[chosen]
     # rule 2: the cut with the answers as labelled points
     cut, note = answered_cut(scores, problem.strategy, answers, problem.test_labels, problem.move)
     base = scores.alignment(cut)
@@ -552,7 +600,8 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = ()) -> QueryState
         predicted[i] = False
         decision[i] = NEVER
     alignment = Alignment(mapping, kscores, threshold=cut, kernel=scores.kernel)
-    return QueryState(problem, answers, chosen, cut, note, predicted, decision, flagged, alignment, mistakes)
+    return QueryState(problem, answers, chosen, cut, note, predicted, decision, flagged, alignment, mistakes,
+                      dict(cands) if cands is not problem.candidates else problem.candidates)
 
 
 # ============================================================================= a session
@@ -587,7 +636,7 @@ def asking(problem: QueryProblem, policy: QueryPolicy | str, answer: Callable[[s
         name = policy.choose(state, rng)
         if name is None:
             return
-        state = state.assume(parse_reply(name, answer(name), state.scores))
+        state = resolve(problem, state.answers + (parse_reply(name, answer(name), state.scores),))
         yield state
 
 
@@ -600,14 +649,39 @@ def ask(problem: QueryProblem, policy: QueryPolicy | str, answer: Callable[[str]
     return state
 
 
+def kernel_rescorer(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
+                    intent: Intent | None = None, *, relevant_train: Sequence[str] = (),
+                    need: Sequence[str] = ("train-calibrated", "non-oracle")
+                    ) -> Callable[[Mapping[str, bool]], AlignmentScores | None] | None:
+    """The ``rescore`` of a :class:`QueryProblem` (rule 5) for ``kernel`` on this scene, or None when the
+    kernel does not implement :meth:`~gift.core.interfaces.RelevanceKernel.score_with_answers` (answers
+    then only re-threshold). Each call asks the kernel again (an LM kernel: new LM calls)."""
+    from gift.core.alignment import rescore_alignment
+    from gift.core.interfaces import RelevanceKernel
+
+    own = getattr(type(kernel), "score_with_answers", None)
+    if not isinstance(kernel, RelevanceKernel) or own is RelevanceKernel.score_with_answers:
+        return None
+    test, train, relevant_train, need = tuple(test), tuple(train), tuple(relevant_train), tuple(need)
+
+    def rescore(answers: Mapping[str, bool]) -> AlignmentScores | None:
+        return rescore_alignment(kernel, test, train, intent, relevant_train=relevant_train, answers=answers,
+                                 need=need)
+
+    return rescore
+
+
 def align_with_queries(kernel: SimilarityKernel, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                        intent: Intent | None = None, *, answer: Callable[[str], Any], n: int = 2,
                        policy: QueryPolicy | str = "uncertainty", relevant_train: Sequence[str] = (),
                        threshold: str | float = "train-calibrated", abstain: float = 0.0,
                        trajectories: Sequence[FeatureBatch] = (),
                        candidates: Mapping[str, AlignmentScores] | None = None,
-                       answers: Sequence[Answer] = (), seed: int = 0) -> QueryState:
+                       answers: Sequence[Answer] = (), seed: int = 0, rescore: bool = True) -> QueryState:
     """Score a scene once with ``kernel``, then ask the human up to ``n`` questions through ``answer``.
+
+    ``rescore``: let the kernel score the scene again with the answers when it can (rule 5; each answer
+    then costs kernel calls); False: answers only re-threshold the first scores.
 
     ``answer(object name) -> bool | str | None`` is the human (see :func:`parse_reply`); the result's
     ``alignment`` is f_ω after the answers, ``abstained`` the flagged objects. Example::
@@ -620,7 +694,9 @@ def align_with_queries(kernel: SimilarityKernel, test: Sequence[ObjectSpec], tra
     need = ("train-calibrated", "non-oracle") if threshold == "train-calibrated" else (
         (threshold,) if isinstance(threshold, str) else ())
     scores = score_alignment(kernel, test, train, intent, relevant_train=relevant_train, need=need)
-    problem = QueryProblem.of(scores, threshold, candidates=candidates, trajectories=trajectories, abstain=abstain)
+    again = kernel_rescorer(kernel, test, train, intent, relevant_train=relevant_train, need=need) if rescore else None
+    problem = QueryProblem.of(scores, threshold, candidates=candidates, trajectories=trajectories, abstain=abstain,
+                              rescore=again)
     return ask(problem, policy, answer, n, answers=answers, seed=seed)
 
 

@@ -352,3 +352,72 @@ def test_query_policies_are_plugins_and_bad_priorities_are_named():
     assert [a.object for a in st.answers] == ["w", "z"]
     with pytest.raises(GiftError, match="'broken' returned"):
         ask(QueryProblem.of(scores_of()), Broken(), labels_answerer(LABELS), 1)
+
+
+class AnswerAware(FixedRelevance):
+    """Fixed tables, and with answers a second fixed table (what a kernel that re-scores would return)."""
+
+    name = "answer-aware"
+
+    def __init__(self, test, train, again):
+        super().__init__(test, train)
+        self.again, self.calls = again, []
+
+    def score_with_answers(self, test, train, intent, relevant_train, answers):
+        self.calls.append(dict(answers))
+        return RelevanceScores([self.again[o.name] for o in test], [self.train[o.name] for o in train],
+                               [o.name in relevant_train for o in train])
+
+
+def test_rule_5_a_kernel_that_uses_answers_re_scores_the_scene_once_per_set_of_answers():
+    from gift.core.queries import align_with_queries, kernel_rescorer
+
+    first = {"x": 0.9, "y": 0.55, "z": 0.45, "w": 0.1}
+    again = {"x": 0.9, "y": 0.2, "z": 0.8, "w": 0.1}  # with the answers, z looks relevant and y does not
+    train = {"a": 0.8, "b": 0.7, "c": 0.3, "d": 0.2}
+    k = AnswerAware(first, train, again)
+    rescore = kernel_rescorer(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"))
+    assert rescore is not None
+    s = score_alignment(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"))
+    p = QueryProblem.of(s, rescore=rescore)
+    st0 = resolve(p)
+    assert not st0.rescored and st0.predicted.tolist() == [True, True, False, False] and k.calls == []
+    st1 = resolve(p, [Answer("x", True)])
+    assert st1.rescored and k.calls == [{"x": True}]
+    assert st1.predicted.tolist() == [True, False, True, False]  # y and z decided by the re-scored table
+    assert st1.to_dict()["rescored"] is True
+    resolve(p, [Answer("x", True)])
+    assert k.calls == [{"x": True}]  # kept per set of answers
+    # a policy's "what if" re-thresholds the current scores without asking the kernel again
+    what_if = st1.assume(Answer("y", False))
+    assert what_if.rescored and k.calls == [{"x": True}]
+    # "don't know" is no evidence: no re-scoring
+    assert not resolve(p, [Answer("y", None)]).rescored and k.calls == [{"x": True}]
+    # the session driver: every real answer re-scores; rescore=False only re-thresholds
+    k.calls.clear()
+    st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
+                            n=2, policy="uncertainty")
+    assert st.rescored and len(k.calls) == 2 and len(k.calls[1]) == 2
+    k.calls.clear()
+    st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
+                            n=2, policy="uncertainty", rescore=False)
+    assert not st.rescored and k.calls == []
+
+
+def test_rule_5_kernels_that_cannot_use_answers_only_re_threshold_and_bad_rescores_fail_clearly():
+    from gift.core.queries import kernel_rescorer
+
+    assert kernel_rescorer(FixedRelevance({"x": 0.5}, {"a": 0.5}), objs(["x"]), objs(["a"])) is None
+    assert kernel_rescorer(FixedMatrix(np.ones((1, 1))), objs(["x"]), objs(["a"])) is None
+    s = scores_of()
+    p = QueryProblem.of(s, rescore=lambda answers: None)  # the kernel declined: the first scores decide
+    assert not resolve(p, [Answer("x", True)]).rescored
+    other = scores_of(test_r={"q": 0.5})
+    bad = QueryProblem.of(s, rescore=lambda answers: other)
+    with pytest.raises(GiftError, match="expected AlignmentScores of the test objects"):
+        resolve(bad, [Answer("x", True)])
+    with pytest.raises(GiftError, match="not test objects"):
+        from gift.core.alignment import rescore_alignment
+
+        rescore_alignment(AnswerAware({"x": 0.5}, {"a": 0.5}, {"x": 0.5}), objs(["x"]), objs(["a"]),
+                          answers={"nope": True})

@@ -47,6 +47,8 @@ class IntentData:
     intent_text: str = ""
     relevant: tuple[str, ...] = ()
     note: str = ""
+    #: The kernel's re-scoring with answers (rule 5 of :mod:`gift.core.queries`), None when it has none.
+    rescore: Any = None
 
 
 def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentData:
@@ -55,6 +57,7 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
     of reach) leaves the win rate out, with a ``note``; in inferred mode the demonstrations are needed."""
     from gift.core.data import Intent
     from gift.core.errors import GiftError
+    from gift.core.queries import kernel_rescorer
     from gift.study.chain import (align_stage, get_training, intent_seeds, intent_stage, relevant_training,
                                   rq1_scenes)
     from gift.study.progress import Progress
@@ -83,14 +86,20 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
         except GiftError as e:
             scenes, note = None, f"test scenes: {e}: no win rate"
     labels = {t.object: t.relevant for t in spec.test}
-    return IntentData(spec.id, scores, labels, scenes, reward, intent.text, tuple(relevant.names), note)
+    kernel = comp.kernel(cfg.kernels[0])
+    again = kernel_rescorer(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                            intent if getattr(kernel, "uses_intent", False) else None,
+                            relevant_train=tuple(relevant.names), need=tuple(cfg.thresholds))
+    return IntentData(spec.id, scores, labels, scenes, reward, intent.text, tuple(relevant.names), note, again)
 
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
-            grid: Sequence[int] = K_GRID, move: str = "nearest") -> list[QueryState]:
-    """The states after k questions for each k of ``grid`` (the last state when every object was asked)."""
+            grid: Sequence[int] = K_GRID, move: str = "nearest", rescore: bool = False) -> list[QueryState]:
+    """The states after k questions for each k of ``grid`` (the last state when every object was asked);
+    ``rescore``: the kernel scores the scene again with the answers (rule 5; LM calls), when it can."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
-    problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move)
+    problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move,
+                              rescore=data.rescore if rescore else None)
     states = list(asking(problem, policy, labels_answerer(data.labels), max(grid), seed=seed))
     return [states[min(k, len(states) - 1)] for k in grid]
 
@@ -122,18 +131,21 @@ def _aggregate(per_intent: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
 
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
-             bands: Sequence[float] = BANDS, move: str = "nearest") -> dict[str, Any]:
+             bands: Sequence[float] = BANDS, move: str = "nearest", rescore: bool = False,
+             policies: Sequence[str] = POLICIES) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
-    at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`). Returns
+    at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
+    the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run. Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention"}``."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
-    for policy in POLICIES + (BASELINE,):
+    for policy in tuple(policies) + (BASELINE,):
         seeds = range(random_seeds) if policy == BASELINE else (0,)
         runs = []  # per seed: [per k: aggregate]
         by_intent: dict[str, list] = {d.intent: [] for d in data}
         for seed in seeds:
-            outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid, move=move)]
+            outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid, move=move,
+                                                                     rescore=rescore)]
                         for d in data}
             runs.append([_aggregate({i: o[k] for i, o in outcomes.items()}) for k in range(len(grid))])
             for i, o in outcomes.items():
@@ -152,13 +164,13 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
                                   "win": [None if runs_i[0][k]["win"] is None else
                                           float(np.mean([o[k]["win"] for o in runs_i])) for k in range(len(grid))]}
                               for i, runs_i in by_intent.items()}
-    for policy in POLICIES:  # which objects each deterministic policy asked about, in order, per intent
+    for policy in policies:  # which objects each deterministic policy asked about, in order, per intent
         for d in data:
-            last = session(d, policy, 0, grid=(max(grid),), move=move)[0]
+            last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     abstention = {}
     for band in bands:
-        outs = {d.intent: outcome(d, session(d, POLICIES[0], 0, band, grid=(0,), move=move)[0]) for d in data}
+        outs = {d.intent: outcome(d, session(d, policies[0], 0, band, grid=(0,), move=move)[0]) for d in data}
         abstention[str(band)] = _aggregate(outs)
     return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention}
 
@@ -183,9 +195,10 @@ def target_check(sim: Mapping[str, Any], at: Sequence[int] = (1, 2, 4)) -> dict[
     reaches and the number of questions random needs to reach it."""
     grid = sim["grid"]
     k2 = grid.index(2)
-    best = max(POLICIES, key=lambda p: (sim["curves"][p]["f1"][k2], -POLICIES.index(p)))
+    run = [p for p in POLICIES if p in sim["curves"]]
+    best = max(run, key=lambda p: (sim["curves"][p]["f1"][k2], -run.index(p)))
     rows = []
-    for k in at:
+    for k in (k for k in at if k in grid):
         f1 = sim["curves"][best]["f1"][grid.index(k)]
         rand = queries_to_reach(grid, sim["curves"][BASELINE]["f1"], f1)
         rows.append({"k": k, "f1": f1, "random_needs": rand,

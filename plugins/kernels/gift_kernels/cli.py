@@ -151,7 +151,10 @@ def run_align(args: argparse.Namespace) -> int:
     scores = score_alignment(kernel, test, train, intent, relevant_train=tuple(args.relevant), need=need)
     state = None
     if args.ask or args.abstain:
-        state = _ask_on_terminal(args, scores, test, threshold)
+        from gift.core.queries import kernel_rescorer
+
+        again = kernel_rescorer(kernel, test, train, intent, relevant_train=tuple(args.relevant), need=need)
+        state = _ask_on_terminal(args, scores, test, threshold, again)
         cut, note, alignment = state.cut, state.note, state.alignment
     else:
         cut, note = scores.threshold(threshold)
@@ -243,8 +246,9 @@ def _answer_text(a: dict) -> str:
     return ("yes" if a["relevant"] else "no") + (f", plays {a['plays']}" if a.get("plays") else "")
 
 
-def _ask_on_terminal(args: argparse.Namespace, scores, test: Sequence[ObjectSpec], threshold):
-    """Ask on stderr/stdin until ``args.ask`` objects of the scene are answered; every answer is saved."""
+def _ask_on_terminal(args: argparse.Namespace, scores, test: Sequence[ObjectSpec], threshold, rescore=None):
+    """Ask on stderr/stdin until ``args.ask`` objects of the scene are answered; every answer is saved.
+    ``rescore``: the kernel's re-scoring with answers (:func:`gift.core.queries.kernel_rescorer`), or None."""
     from gift.core.queries import Answer, QueryProblem, ask, parse_reply
 
     path = _answers_path(args)
@@ -281,5 +285,5 @@ def _ask_on_terminal(args: argparse.Namespace, scores, test: Sequence[ObjectSpec
 
     if known:
         sys.stderr.write(f"using {len(known)} saved answer(s) from {path}\n")
-    problem = QueryProblem.of(scores, threshold, abstain=args.abstain)
+    problem = QueryProblem.of(scores, threshold, abstain=args.abstain, rescore=rescore)
     return ask(problem, args.policy, answer, new, answers=known)

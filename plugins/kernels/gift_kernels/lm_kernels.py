@@ -671,6 +671,52 @@ class GiftProbKernel(RelevanceKernel):
             rel = self._relevant_mask(train, (), lo[len(test):])
         if self._uses_ladder(intent) and rel.any() and uses_category:
             lo = self._ladder_term(test, train, intent, rel, lo, details)
+        return self._finish(test, train, rel, lo, details)
+
+    def score_with_answers(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None,
+                           relevant_train: Sequence[str], answers: Mapping[str, bool]) -> RelevanceScores | None:
+        """The scene scored again with the human's answers (rule 5 of :mod:`gift.core.queries`): the category
+        ladder is named again with the test objects answered "yes" beside the demonstrated ones and those
+        answered "no" beside the left-alone ones, every object is asked about the new rungs, and the LM term
+        is the mean of the z-scored log-odds under the goal's category (unchanged) and the new rungs; then
+        the terms are combined as in :meth:`score`. Cost: one ladder call and ``n_test + n_train`` yes/no
+        questions per rung. The training objects are asked about the new rungs as named with them (not held
+        out: an answer adds test objects to the evidence, and naming the rungs once per training object would
+        cost a ladder call each). None when the scene does not use the ladder (``ladder="never"``, or a
+        ground-truth intent with ``"inferred"``) or the LM names no rung: answers then only re-threshold.
+        ``details["ladder"]["answers"]`` lists the answers used."""
+        test, train = list(test), list(train)
+        names = [o.name for o in test]
+        unknown = sorted(set(answers) - set(names))
+        if unknown:
+            raise GiftError(f"gift-prob: answers about {unknown}, which are not test objects {names}")
+        base = self.score(test, train, intent, relevant_train)  # every LM answer of it is memoized
+        lad = base.details.get("ladder")
+        if lad is None or not answers:
+            return None
+        yes = [n for n in names if answers.get(n) is True]
+        no = [n for n in names if answers.get(n) is False]
+        rel = np.asarray(base.relevant, dtype=bool)
+        handled, alone = self._split(train, rel)
+        rungs = self.ladder(handled + yes, alone + no)
+        if not rungs:
+            return None
+        goal = np.asarray(lad["goal"], dtype=float)
+        n_all = len(test) + len(train)
+        terms = [self.log_odds(test + train, intent, [r] * n_all) for r in rungs]
+        details = {k: v for k, v in base.details.items() if k in ("category", "goal")}
+        details["ladder"] = {"categories": list(rungs), "goal": goal.tolist(),
+                             "terms": [{"test": v[: len(test)].tolist(), "train": v[len(test):].tolist()}
+                                       for v in terms],
+                             "answers": {"yes": yes, "no": no}, "train_held_out": False,
+                             "categories_before": list(lad["categories"])}
+        lo = np.mean([_zscore(v) for v in [goal, *terms]], axis=0)
+        return self._finish(test, train, rel, lo, details)
+
+    def _finish(self, test: list[ObjectSpec], train: list[ObjectSpec], rel: np.ndarray, lo: np.ndarray,
+                details: dict[str, Any]) -> RelevanceScores:
+        """The scores from the LM term ``lo`` ``[n_test + n_train]``: combined with the MiniLM term (or
+        calibrated, or alone), with the terms, weights and ladder views in ``details``."""
         lo_test, lo_train = lo[: len(test)], lo[len(test):]
         details["terms"] = {"lm": {"test": lo_test.tolist(), "train": lo_train.tolist()}}
         if self.combine == "none":
