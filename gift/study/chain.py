@@ -97,7 +97,8 @@ class StudyConfig:
     to use instead of simulating the human. ``queries``: questions per intent and kernel that the simulated
     human (the suite's labels) answers, chosen by the registered ``query_policy``; ``abstain``: the
     abstention band around the cut (:mod:`gift.core.queries`); with either, each kernel gets a second row
-    (:func:`query_label`) in RQ1 and RQ2.
+    (:func:`query_label`) in RQ1 and RQ2. ``query_rescore``: a kernel that can use the answers scores the
+    scene again with them (rule 5 of :mod:`gift.core.queries`; LM calls), else answers only re-threshold.
     """
 
     suite: str = "gift-paper"
@@ -127,6 +128,7 @@ class StudyConfig:
     queries: int = attrs.field(default=0, validator=_non_negative)
     query_policy: str = "uncertainty"
     abstain: float = attrs.field(default=0.0, validator=_band)
+    query_rescore: bool = True
 
     def key(self) -> str:
         """A short hash of the configuration (names the run in the manifest)."""
@@ -354,21 +356,37 @@ def query_threshold(cfg: StudyConfig) -> str:
 
 
 def query_stage(cfg: StudyConfig, spec: IntentSpec, scores: AlignmentScores,
-                trajectories: Sequence[FeatureBatch] = ()) -> dict[str, Any]:
+                trajectories: Sequence[FeatureBatch] = (), rescore: Any = None) -> dict[str, Any]:
     """Up to ``cfg.queries`` questions about the intent's test objects, chosen by ``cfg.query_policy`` and
     answered from the suite's labels (the simulated human), abstaining within ``cfg.abstain`` of the cut
-    of :func:`query_threshold`; no kernel runs again (:mod:`gift.core.queries`). ``trajectories``: the test
-    scenes' features, for the error bound. Returns :meth:`QueryState.to_dict` with the policy and the
+    of :func:`query_threshold`. ``trajectories``: the test scenes' features, for the error bound; ``rescore``:
+    the kernel's re-scoring with answers (:func:`rescorer`; used when ``cfg.query_rescore``), None: no kernel
+    runs again. Returns :meth:`QueryState.to_dict` with the policy and the
     metrics per subset (``{threshold: {subset: ...}}``)."""
     from gift.core.queries import QueryProblem, ask, labels_answerer
 
     labels, th = test_labels(spec), query_threshold(cfg)
     problem = QueryProblem.of(scores, th, trajectories=trajectories, abstain=cfg.abstain,
-                              test_labels=labels if th == "oracle" else None)
+                              test_labels=labels if th == "oracle" else None,
+                              rescore=rescore if cfg.query_rescore else None)
     state = ask(problem, cfg.query_policy, labels_answerer(labels), cfg.queries, seed=stable_seed("queries", spec.id))
     metrics = alignment_metrics(state.decision, [t.relevant for t in spec.test], subset_masks(spec), {th: state.cut})
+    ladder = (state.scores.details.get("ladder") or {}) if state.rescored else {}
     return {"policy": cfg.query_policy, "queries": cfg.queries, "abstain": cfg.abstain, "threshold": th,
-            **state.to_dict(), "metrics": metrics}
+            **state.to_dict(), "rescored_ladder": list(ladder.get("categories") or []), "metrics": metrics}
+
+
+def rescorer(cfg: StudyConfig, suite: Suite, spec: IntentSpec, kernel: Any, intent: Intent | None,
+             relevant: Sequence[str]) -> Any:
+    """The ``rescore`` of :func:`query_stage` for ``kernel`` on the intent's test scene (None when the study
+    does not re-score or the kernel cannot use answers: :func:`gift.core.queries.kernel_rescorer`)."""
+    from gift.core.queries import kernel_rescorer
+
+    if not cfg.query_rescore:
+        return None
+    return kernel_rescorer(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                           intent if getattr(kernel, "uses_intent", False) else None,
+                           relevant_train=tuple(relevant), need=tuple(cfg.thresholds))
 
 
 def oracle_alignment(spec: IntentSpec) -> Alignment:
@@ -531,8 +549,9 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
         for kspec, rec in list(results["alignment"].get(spec.id, {}).items()):
             label = query_label(kspec, cfg)
             say(f"[{spec.id}] {label}: asking the simulated human")
+            again = rescorer(cfg, suite, spec, comp.kernel(kspec), intent, relevant.names)
             q = timed("queries", lambda: query_stage(cfg, spec, AlignmentScores.from_dict(rec["scores"]),
-                                                     [f for f, _, _ in scenes or ()]))
+                                                     [f for f, _, _ in scenes or ()], again))
             rec["queries"] = q
             results["rq2"][spec.id][label] = {q["threshold"]: q["metrics"][q["threshold"]]}
             aligned[label] = Alignment(q["mapping"], q["scores"], q["cut"], kernel=label)

@@ -51,6 +51,7 @@ from gift.study.chain import (
     alignment_record,
     query_stage,
     query_threshold,
+    rescorer,
     subset_masks,
 )
 from gift.study.components import check_spec, components_for
@@ -340,7 +341,9 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
         try:
             scores, cuts, metrics = score_intent(kernel, suite, spec, intent, relevant.names, cfg.thresholds)
             # the simulated human answers (no trajectories here: the error bound counts one state per object)
-            queried = query_stage(cfg, spec, scores) if cfg.queries or cfg.abstain else None
+            queried = query_stage(cfg, spec, scores, rescore=rescorer(cfg, suite, spec, kernel, intent,
+                                                                      relevant.names)) \
+                if cfg.queries or cfg.abstain else None
         except Exception as e:  # noqa: BLE001 - one failing intent must not lose the others
             failure = Failure.current(e)
             out = ItemOutcome(item.kernel, item.intent_id, error=failure.text, seconds=time.perf_counter() - t0,
@@ -460,7 +463,8 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                        checkpoint: Callable[[dict[str, Any]], None] | None = None,
                        executor: Executor | str | None = None, echo: bool = False,
                        stages: str | Path | None = None, config: StudyConfig | None = None,
-                       queries: int = 0, query_policy: str = "uncertainty", abstain: float = 0.0) -> dict[str, Any]:
+                       queries: int = 0, query_policy: str = "uncertainty", abstain: float = 0.0,
+                       query_rescore: bool = True) -> dict[str, Any]:
     """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
 
     The work is one :class:`AlignItem` per (kernel, intent) on ``executor`` (None: ``serial``); with
@@ -471,7 +475,8 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     each line to stderr as soon as it is done). ``stages``: a directory for the stage cache of the
     inferred intents. ``config``: the study sizes for the demonstrations (default :class:`StudyConfig`).
     ``queries`` / ``query_policy`` / ``abstain``: questions per kernel and intent answered from the suite's
-    labels, and the abstention band (:func:`~gift.study.chain.query_stage`); results under ``queries``.
+    labels, and the abstention band (:func:`~gift.study.chain.query_stage`); results under ``queries``;
+    ``query_rescore``: the kernel scores the scene again with the answers when it can (rule 5).
     """
     started, t0 = time.time(), time.perf_counter()
     if isinstance(suite, str):
@@ -489,7 +494,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     cfg = attrs.evolve(base, suite=suite.path or suite.name, robot=robot, lm=lm, kernels=tuple(kernels),
                        intents=tuple(intents or ()), intent_source=intent_source, thresholds=tuple(thresholds),
                        rq1=False, rq3=False, sanity_reps=0, queries=queries, query_policy=query_policy,
-                       abstain=abstain)
+                       abstain=abstain, query_rescore=query_rescore)
     if queries or abstain:
         check = check_spec("query_policy", query_policy)
         if check is not None:
@@ -498,7 +503,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     out: dict[str, Any] = {"suite": suite.name, "suite_path": suite.path, "intent_source": intent_source,
                            "thresholds": list(thresholds), "lm": lm, "kernels": {}}
     if queries or abstain:
-        out["queries"] = {"n": queries, "policy": query_policy, "abstain": abstain,
+        out["queries"] = {"n": queries, "policy": query_policy, "abstain": abstain, "rescore": query_rescore,
                           "threshold": query_threshold(cfg)}
     out_dir = None if stages is None else str(Path(stages).resolve())
     with using_executor(executor) as ex:

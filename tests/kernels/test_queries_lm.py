@@ -3,6 +3,7 @@ objects), with answers simulated from the suite's labels. The kernel runs once; 
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +13,8 @@ import gift
 from gift.core.alignment import score_alignment
 from gift.core.data import DISTRACTOR, Intent
 from gift.core.metrics import binary_metrics
-from gift.core.queries import (QueryProblem, align_with_queries, answered_cut, ask, asking, belief, labels_answerer,
-                               resolve)
+from gift.core.queries import (QueryProblem, align_with_queries, answered_cut, ask, asking, belief, kernel_rescorer,
+                               labels_answerer, resolve)
 from gift.core.suite import load_suite
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm]
@@ -108,3 +109,73 @@ def test_a_python_callback_on_the_real_kernel_without_new_lm_questions(scene):
     assert len(asked) == 2 and [a.object for a in st.answers] == asked
     assert f1(st, labels) >= f1(resolve(QueryProblem.of(scores, abstain=0.02)), labels)
     assert all(abs(scores.decision[TEST.index(t)] - st.cut) < 0.02 for t in st.abstained)
+
+
+def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
+    """Rule 5 on the real kernel: with the ladder on (an inferred intent), each answer names the ladder again
+    with the answered objects and every object is asked about the new rungs."""
+    from gift_kernels.lm_kernels import _zscore
+
+    kernel, test, train, _, spec, _, labels = scene
+    inferred = Intent(text=spec.text, source="inferred")  # gift-prob's ladder is on for inferred intents
+    first = score_alignment(kernel, test, train, inferred, relevant_train=spec.relevant_train)
+    assert first.details["ladder"]["categories"]
+    rescore = kernel_rescorer(kernel, test, train, inferred, relevant_train=spec.relevant_train)
+    calls = kernel.calls
+    states = list(asking(QueryProblem.of(first, rescore=rescore), "uncertainty", labels_answerer(labels), 2))
+    assert kernel.calls > calls  # a new ladder call and new yes/no questions
+    assert [s.rescored for s in states] == [False, True, True]
+    after = states[-1]
+    lad = after.scores.details["ladder"]
+    yes = [a.object for a in after.answers if a.relevant]
+    no = [a.object for a in after.answers if not a.relevant]
+    assert lad["answers"] == {"yes": [t for t in TEST if t in yes], "no": [t for t in TEST if t in no]}
+    assert lad["categories_before"] == first.details["ladder"]["categories"] and lad["train_held_out"] is False
+    # the LM term is the mean of the z-scored goal term (unchanged) and the log-odds under the new rungs
+    goal = np.asarray(lad["goal"])
+    assert np.allclose(goal, first.details["ladder"]["goal"])
+    rungs = [np.asarray(t["test"] + t["train"]) for t in lad["terms"]]
+    assert len(rungs) == len(lad["categories"]) >= 1
+    lm = np.mean([_zscore(v) for v in [goal, *rungs]], axis=0)
+    assert np.allclose(after.scores.details["terms"]["lm"]["test"], lm[: len(TEST)])
+    # answered objects are fixed; the unasked ones are decided by the re-scored scene at the state's cut
+    for i, t in enumerate(TEST):
+        a = after.answer_of(t)
+        want = labels[t] if a is not None else after.scores.decision[i] >= after.cut
+        assert after.predicted[i] == want
+    # the same answers again: every LM answer is remembered
+    calls = kernel.calls
+    again = ask(QueryProblem.of(first, rescore=rescore), "uncertainty", labels_answerer(labels), 2)
+    assert kernel.calls == calls and np.array_equal(again.predicted, after.predicted)
+
+
+def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_not_to(tmp_path, capsys):
+    """``gift evaluate-alignment --queries 1`` on one intent with gift-prob's ladder on: the answer re-names the
+    ladder (rule 5); ``--no-rescore`` gives the session that only re-thresholds the same first scores."""
+    from gift.cli import main
+
+    runs = {}
+    for flag in ([], ["--no-rescore"]):
+        out = tmp_path / f"res{len(flag)}.json"
+        assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", "gift-prob:ladder=always", "--intents",
+                     "art_supplies", "--threshold", "train-calibrated", "--queries", "1", "--out", str(out),
+                     "--executor", "serial", "-q"] + flag) == 0
+        runs[bool(flag)] = json.loads(out.read_text())
+    on, off = runs[False], runs[True]
+    assert on["queries"]["rescore"] is True and off["queries"]["rescore"] is False
+    q_on = on["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]
+    q_off = off["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]
+    assert q_on["rescored"] is True and q_off["rescored"] is False
+    assert q_on["rescored_ladder"] and q_off["rescored_ladder"] == []
+    assert q_on["answers"] == q_off["answers"]  # the same first question, from the same first scores
+    labels = {t.object: t.relevant for t in load_suite(SUITE).intent("art_supplies").test}
+    (a,) = q_on["answers"]
+    assert a["relevant"] == labels[a["object"]] and q_on["predicted"][a["object"]] == a["relevant"]
+    # without re-scoring, the session is the offline one on the saved scores
+    from gift.core.alignment import AlignmentScores
+    from gift.study.scenes import stable_seed
+
+    scores = AlignmentScores.from_dict(off["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["scores"])
+    st = ask(QueryProblem.of(scores, "train-calibrated"), "uncertainty", labels_answerer(labels), 1,
+             seed=stable_seed("queries", "art_supplies"))
+    assert st.to_dict()["predicted"] == q_off["predicted"]

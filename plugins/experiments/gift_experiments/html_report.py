@@ -624,6 +624,9 @@ class Report:
                          if was is not None or now is not None else "")
                 items.append(f'<li data-object="{esc(o)}"><b>{esc(o)}</b>: {esc(_answer_word(a))}{moved}</li>')
             asked = f"<ol>{''.join(items)}</ol>" if items else '<span class="missing">no question asked</span>'
+            if q.get("rescored_ladder"):
+                asked += (f'<small class="rescored">re-scored with the answers; ladder named again: '
+                          f'{esc(" > ".join(q["rescored_ladder"]))}</small>')
             ab = q.get("abstained") or []
             ba = self._before_after(intent, kernel, row, q)
             out.append(f'<tr class="query-row" data-intent="{esc(intent)}" data-kernel="{esc(kernel)}">'

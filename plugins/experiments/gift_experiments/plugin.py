@@ -65,6 +65,9 @@ def add_query_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects whose decision score is within BAND of the cut; "
                         "their features are dropped like a distractor's (default 0: never)")
+    p.add_argument("--no-rescore", dest="rescore", action="store_false",
+                   help="answers only re-threshold the first scores; by default a kernel that can use them "
+                        "(gift-prob with its category ladder) scores the scene again after each answer (LM calls)")
 
 
 def _check_queries(args: argparse.Namespace) -> None:
@@ -127,7 +130,7 @@ def _config_from_args(args: argparse.Namespace):
                        thresholds=_split(args.thresholds), train_scenes=args.train_scenes,
                        sanity_reps=args.sanity_reps, trajectories_per_generator=args.trajectories,
                        rq3=not args.no_rq3, demonstrations=args.demonstrations, queries=args.queries,
-                       query_policy=args.policy, abstain=args.abstain)
+                       query_policy=args.policy, abstain=args.abstain, query_rescore=args.rescore)
 
 
 def run_study_command(cfg, out: Path, command: str, executor=None) -> dict:
@@ -273,7 +276,8 @@ def run_evaluate_alignment(args: argparse.Namespace) -> int:
                                     lm=args.lm, intents=intents, robot=args.robot, progress=log.info,
                                     checkpoint=write if args.out else None, executor=executor,
                                     echo=not executor.in_process and executor.live_stderr, stages=stages,
-                                    queries=args.queries, query_policy=args.policy, abstain=args.abstain)
+                                    queries=args.queries, query_policy=args.policy, abstain=args.abstain,
+                                    query_rescore=args.rescore)
     if args.json:
         from gift.core.serialization import to_jsonable
 
