@@ -2,9 +2,9 @@
 
 When the intent-conditioned kernel is unsure about a test object, gift can ask the human "is this object
 part of the goal?" (and, optionally, "which training object does it play?") instead of guessing, and it
-can *abstain*: leave an object it is unsure of out of the aligned reward. Nothing here calls a kernel or
-an LM again: a scene is scored once (:func:`gift.core.alignment.score_alignment`) and every answer only
-re-thresholds those scores.
+can *abstain*: leave an object it is unsure of out of the aligned reward. A scene is scored once
+(:func:`gift.core.alignment.score_alignment`); answers re-threshold those scores, and a kernel that can use
+them scores the scene again with them (rule 5; without a ``rescore`` nothing here calls a kernel again).
 
 The pieces
 ----------
