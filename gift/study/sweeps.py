@@ -464,7 +464,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                        executor: Executor | str | None = None, echo: bool = False,
                        stages: str | Path | None = None, config: StudyConfig | None = None,
                        queries: int = 0, query_policy: str = "uncertainty", abstain: float = 0.0,
-                       query_rescore: bool = True) -> dict[str, Any]:
+                       query_rescore: bool = False) -> dict[str, Any]:
     """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
 
     The work is one :class:`AlignItem` per (kernel, intent) on ``executor`` (None: ``serial``); with

@@ -151,17 +151,17 @@ def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
 
 def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_not_to(tmp_path, capsys):
     """``gift evaluate-alignment --queries 1`` on one intent with gift-prob's ladder on: the answer re-names the
-    ladder (rule 5); ``--no-rescore`` gives the session that only re-thresholds the same first scores."""
+    ladder (rule 5) with ``--rescore``; without it, the session only re-thresholds the same first scores."""
     from gift.cli import main
 
     runs = {}
-    for flag in ([], ["--no-rescore"]):
-        out = tmp_path / f"res{len(flag)}.json"
+    for flag in (["--rescore"], []):
+        out = tmp_path / f"res{len(flag)}.json"  # res1: --rescore, res0: without
         assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", "gift-prob:ladder=always", "--intents",
                      "art_supplies", "--threshold", "train-calibrated", "--queries", "1", "--out", str(out),
                      "--executor", "serial", "-q"] + flag) == 0
         runs[bool(flag)] = json.loads(out.read_text())
-    on, off = runs[False], runs[True]
+    on, off = runs[True], runs[False]
     assert on["queries"]["rescore"] is True and off["queries"]["rescore"] is False
     q_on = on["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]
     q_off = off["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]

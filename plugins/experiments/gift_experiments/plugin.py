@@ -65,9 +65,9 @@ def add_query_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects whose decision score is within BAND of the cut; "
                         "their features are dropped like a distractor's (default 0: never)")
-    p.add_argument("--no-rescore", dest="rescore", action="store_false",
-                   help="answers only re-threshold the first scores; by default a kernel that can use them "
-                        "(gift-prob with its category ladder) scores the scene again after each answer (LM calls)")
+    p.add_argument("--rescore", action="store_true",
+                   help="a kernel that can use the answers (gift-prob with its category ladder) scores the scene "
+                        "again after each answer (LM calls); default: answers only re-threshold the first scores")
 
 
 def _check_queries(args: argparse.Namespace) -> None:
