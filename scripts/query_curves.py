@@ -100,6 +100,29 @@ def run(args: argparse.Namespace) -> dict:
     return out
 
 
+def merge(results: list[dict]) -> dict:
+    """One result from several saved ones (each a ``curves.json``): their runs, suites and failures together;
+    the first one's provenance, with every one's command, commit and code version kept under ``parts``.
+    Runs of different recipes (kernel, re-scoring, LM model file) are refused."""
+    first = results[0]
+    keys = ("kernel", "rescore", "random_seeds")
+    for r in results[1:]:
+        for k in keys:
+            if r.get(k) != first.get(k):
+                raise SystemExit(f"cannot merge runs with different {k}: {first.get(k)!r} and {r.get(k)!r}")
+        if (r.get("lm") or {}).get("model_sha256") != (first.get("lm") or {}).get("model_sha256"):
+            raise SystemExit("cannot merge runs made with different LM model files")
+    out = {**first, "runs": {}, "suites": {}, "failures": [], "seconds": 0.0,
+           "parts": [{k: r.get(k) for k in ("command", "git", "code_version", "seconds")} for r in results]}
+    for r in results:
+        out["runs"].update(r["runs"])
+        out["suites"].update(r["suites"])
+        out["failures"] += r.get("failures", [])
+        out["seconds"] += r.get("seconds") or 0.0
+    out["command"] = " ; ".join(r["command"] for r in results)
+    return out
+
+
 def figure_dir(md: Path) -> str:
     """The directory, next to the page ``md``, of its figures and curves.json: ``queries`` for queries.md,
     else the page's own stem (so a second page never overwrites the first one's figures)."""
@@ -128,7 +151,9 @@ def write(result: dict, md: Path) -> None:
               "[the front half](front_half.md)." if kernel == "gift-prob" else
               f"`{kernel}`: `gift-prob` with these options, otherwise its default recipe at the commit below "
               "(the default is measured in [queries.md](queries.md) and [the front half](front_half.md)).")
-    lines = ["# Asking instead of guessing: query policies and abstention", "",
+    title = ("# Answers that re-score the scene: query curves with rule 5" if result.get("rescore") else
+             "# Asking instead of guessing: query policies and abstention")
+    lines = [title, "",
              "When the intent-conditioned kernel is unsure, gift can ask the human \"is this object part of the "
              "goal?\" about a few test objects and re-score the scene with the answers, or abstain on an object "
              "(leave it out of the aligned reward). The rules (answered objects are fixed; answers join the "
@@ -168,6 +193,15 @@ def write(result: dict, md: Path) -> None:
                      f"{rand['f1'][k2]:.3f}); random needs {needs} questions per intent for that F1"
                      + (f" (ratio {row2['ratio']:.2f})" if row2["ratio"] else "") + f". Win rate "
                      f"{_fmt(best['win'][0])} -> {_fmt(best['win'][k2])} (random {_fmt(rand['win'][k2])}).")
+        if "without_rescore" in r:
+            w = r["without_rescore"]
+            wb = max(qc.POLICIES, key=lambda p: w[p]["f1"][k2])
+            lines.append(f"  Without re-scoring (answers only re-threshold), the same sessions: best after 2 questions "
+                         f"{w[wb]['f1'][k2]:.3f} (`{wb}`), random {w[qc.BASELINE]['f1'][k2]:.3f}; after 1 question "
+                         f"best {max(w[p]['f1'][grid.index(1)] for p in qc.POLICIES):.3f} against "
+                         f"{max(r['curves'][p]['f1'][grid.index(1)] for p in qc.POLICIES):.3f} with it."
+                         if 1 in grid else
+                         f"  Without re-scoring: best after 2 questions {w[wb]['f1'][k2]:.3f} (`{wb}`).")
     paper_inferred = [r for r in result["runs"].values()
                       if r["suite"] == "gift-paper" and r["intent_source"] == "inferred"]
     if paper_inferred:
@@ -181,10 +215,10 @@ def write(result: dict, md: Path) -> None:
                      "measured in this version (ground-truth intents only); `--intent-sources inferred` measures it.")
     lines += ["- Target 2 (the best policy needs at most half the questions random needs for the same F1): the "
               "ratios in each suite's table below; 0.5 or less meets it.",
-              "- The rule by which answers move the cut was changed once, after the first `gift-paper` run: the "
-              "first rule (the widest-gap midpoint) let one or two hard negatives lift the cut past unasked "
-              "relevant objects (its numbers are in each suite's table below). The dev suites were first run "
-              "with the adopted rule.",
+              *(["- The rule by which answers move the cut was changed once, after the first `gift-paper` run: the "
+                 "first rule (the widest-gap midpoint) let one or two hard negatives lift the cut past unasked "
+                 "relevant objects (its numbers are in each suite's table below). The dev suites were first run "
+                 "with the adopted rule."] if any("widest" in r for r in result["runs"].values()) else []),
               "- Win rates depend on the simulator's scenes at the commit below: the k = 0 row is `gift reproduce "
               "--kernels gift-prob` at the same commit and sizes.", ""]
     for source in sources:
@@ -283,7 +317,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rescore", action="store_true",
                    help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "
                         "the curves without it are kept next to them")
+    p.add_argument("--from-json", nargs="+", default=None, metavar="CURVES_JSON",
+                   help="write --out from saved curves.json files (their runs merged, nothing recomputed): one page "
+                        "from runs made in separate processes")
     args = p.parse_args(argv)
+    if args.from_json:
+        logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s", datefmt="%H:%M:%S")
+        write(merge([json.loads(Path(f).read_text(encoding="utf-8")) for f in args.from_json]), Path(args.out))
+        print(f"wrote {args.out} from {len(args.from_json)} saved run file(s)")
+        return 0
     args.grid = tuple(int(k) for k in args.grid.split(","))
     args.policies = tuple(s.strip() for s in args.policies.split(",") if s.strip())
     if 2 not in args.grid or 0 not in args.grid:
