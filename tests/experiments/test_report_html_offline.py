@@ -214,6 +214,51 @@ def test_questions_asked_section_shows_policy_answers_and_before_after_plots(tmp
     assert not re.search(r'(src|href)="https?:', page)
 
 
+def test_a_kernel_that_re_scores_with_the_answers_shows_its_new_ladder(tmp_path):
+    """``query_rescore``: the study's session lets a kernel that implements ``score_with_answers`` score the
+    scene again (fixed tables here; the real gift-prob: tests/kernels/test_queries_lm.py), the record names the
+    ladder it named again, and report.html shows it under the answers."""
+    from gift.core.alignment import score_alignment
+    from gift.core.data import RelevanceScores
+    from gift.core.interfaces import RelevanceKernel
+    from gift.core.serialization import to_jsonable
+    from gift.study.chain import StudyConfig, query_stage, rescorer
+
+    class Rescoring(RelevanceKernel):
+        name = "rescoring"
+
+        def __init__(self):
+            self.answers = []
+
+        def score(self, test, train, intent=None, relevant_train=()):
+            return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
+                                   [0.8 if o.name in relevant_train else 0.2 for o in train],
+                                   [o.name in relevant_train for o in train])
+
+        def score_with_answers(self, test, train, intent, relevant_train, answers):
+            self.answers.append(dict(answers))
+            first = self.score(test, train, intent, relevant_train)
+            return RelevanceScores(first.relevance[::-1], first.train_loo, first.relevant,
+                                   {"ladder": {"categories": ["jewelry", "small valuables"]}})
+
+    suite = gift.load_suite(str(MINI))
+    spec = suite.intent("valuables")
+    kernel = Rescoring()
+    scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                             relevant_train=spec.relevant_train)
+    cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
+                      thresholds=("train-calibrated",))
+    assert rescorer(cfg, suite, spec, kernel, None, spec.relevant_train) is None  # off by default
+    cfg = attrs.evolve(cfg, query_rescore=True)
+    q = query_stage(cfg, spec, scores, rescore=rescorer(cfg, suite, spec, kernel, None, spec.relevant_train))
+    assert q["rescored"] is True and q["rescored_ladder"] == ["jewelry", "small valuables"]
+    assert [len(a) for a in kernel.answers] == [1, 2]  # once per answer
+    results = results_with_queries()
+    results["alignment"]["valuables"]["language"]["queries"] = to_jsonable(q, nonfinite="null")
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert "re-scored with the answers; ladder named again: jewelry &gt; small valuables" in page
+
+
 def test_no_questions_no_section(tmp_path):
     results = results_with_queries()
     del results["alignment"]["valuables"]["language"]["queries"]
