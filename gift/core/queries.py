@@ -48,6 +48,12 @@ How answers update the scene (the rule)
    of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
    fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
    The chosen candidate's scores, re-thresholded by rule 2, decide the objects not answered.
+4. **Abstention.** An object not answered (or answered "don't know") whose decision score lies strictly
+   within ``abstain`` of the cut, ``|decision - cut| < abstain``, is *flagged* instead of decided: it is
+   reported, and its semantic features are held out of scoring exactly as a distractor's are (its
+   feature columns are dropped by f_ω, so the aligned reward neither seeks nor avoids it, and it adds 0
+   to the error bound). The report counts flagged objects; alignment metrics count a flagged object as
+   not aligned (that is what the reward sees), and :meth:`QueryState.to_dict` also lists them.
 5. **A kernel that can use answers re-scores the scene with them.** When the problem has a ``rescore``
    callable (:func:`kernel_rescorer`: the kernel implements
    :meth:`~gift.core.interfaces.RelevanceKernel.score_with_answers`), each time the set of answers with a
@@ -56,12 +62,6 @@ How answers update the scene (the rule)
    category ladder again with the "yes" objects beside the demonstrated ones and the "no" objects beside
    the left-alone ones. Re-scored scenes are kept per set of answers, and a policy's "what if" states
    (:meth:`QueryState.assume`) re-threshold the current scores without re-scoring.
-4. **Abstention.** An object not answered (or answered "don't know") whose decision score lies strictly
-   within ``abstain`` of the cut, ``|decision - cut| < abstain``, is *flagged* instead of decided: it is
-   reported, and its semantic features are held out of scoring exactly as a distractor's are (its
-   feature columns are dropped by f_ω, so the aligned reward neither seeks nor avoids it, and it adds 0
-   to the error bound). The report counts flagged objects; alignment metrics count a flagged object as
-   not aligned (that is what the reward sees), and :meth:`QueryState.to_dict` also lists them.
 
 Intent candidates and terms a kernel reports
 --------------------------------------------
