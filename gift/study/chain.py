@@ -550,7 +550,9 @@ def run_intent(job: IntentJob, *, comp: Components | None = None, progress: Prog
         for kspec, rec in list(results["alignment"].get(spec.id, {}).items()):
             label = query_label(kspec, cfg)
             say(f"[{spec.id}] {label}: asking the simulated human")
-            again = rescorer(cfg, suite, spec, comp.kernel(kspec), intent, relevant.names)
+            # the kernel (and its LM) is built only when the study re-scores with the answers
+            again = rescorer(cfg, suite, spec, comp.kernel(kspec), intent, relevant.names) if cfg.query_rescore \
+                else None
             q = timed("queries", lambda: query_stage(cfg, spec, AlignmentScores.from_dict(rec["scores"]),
                                                      [f for f, _, _ in scenes or ()], again))
             rec["queries"] = q

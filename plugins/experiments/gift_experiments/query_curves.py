@@ -86,10 +86,15 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
         except GiftError as e:
             scenes, note = None, f"test scenes: {e}: no win rate"
     labels = {t.object: t.relevant for t in spec.test}
-    kernel = comp.kernel(cfg.kernels[0])
-    again = kernel_rescorer(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
-                            intent if getattr(kernel, "uses_intent", False) else None,
-                            relevant_train=tuple(relevant.names), need=tuple(cfg.thresholds))
+
+    def again(answers: Mapping[str, bool]) -> AlignmentScores | None:
+        """Re-scoring with answers (rule 5); the kernel (and its LM) is built only when a session re-scores."""
+        kernel = comp.kernel(cfg.kernels[0])
+        rescore = kernel_rescorer(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                                  intent if getattr(kernel, "uses_intent", False) else None,
+                                  relevant_train=tuple(relevant.names), need=tuple(cfg.thresholds))
+        return None if rescore is None else rescore(answers)
+
     return IntentData(spec.id, scores, labels, scenes, reward, intent.text, tuple(relevant.names), note, again)
 
 
