@@ -605,7 +605,39 @@ def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_
     examples = [(g, h + a, c) for g, h, a, c in prompts.CATEGORY_EXAMPLES_WITH_OBJECTS]
     examples += [(g, (), c) for g, c in prompts.CATEGORY_EXAMPLES]
     examples += [("", h + a, " ".join(names)) for h, a, names in prompts.LADDER_EXAMPLES]
+    examples += [("", h + a, " ".join(names)) for h, a, names in prompts.FACET_EXAMPLES]
     for goal, objs, category in examples:
         assert not {o.lower() for o in objs} & objects, objs
         words = set(re.findall(r"[a-z]+", f"{goal} {category}".lower())) - stop
         assert not words & goal_words, (goal, words & goal_words)
+
+
+def test_gift_prob_faceted_ladder_drops_none_and_matches_each_training_objects_rungs_by_facet():
+    """rungs="facets": the LM names the kind, the material and a property the demonstrated objects share;
+    "none" is no rung, and a training object's own ladder (named without it) is matched to the full one by
+    facet, the full ladder's name standing in where its own names none."""
+    def answer(messages, seed):
+        assert messages[0].content != prompts.LADDER_SYSTEM  # the breadth prompt is not asked
+        if messages[0].content == prompts.FACET_SYSTEM:
+            if "specially: sketchbook.\n" in messages[-1].content:
+                return json.dumps({"kind": "drawing books", "material": "N/A", "property": "paper goods"})
+            return json.dumps({"kind": "art supplies", "material": "none", "property": "things that stain"})
+        return category_json("fruit")
+
+    lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", rungs="facets")
+    rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+    assert rs.details["ladder"]["categories"] == ["art supplies", "things that stain"]
+    assert k.ladder(["sketchbook"], ["banana", "coffee mug"]) == ("drawing books", "paper goods")
+    asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
+    # the paintbrush (left out) is asked about its own kind and property; the test objects about the full ones
+    assert any(q.startswith("Is a paintbrush (a brush for paint) one of the drawing books?") for q in asked)
+    assert any(q.startswith("Is a paintbrush (a brush for paint) one of the paper goods?") for q in asked)
+    assert any(q.startswith("Is a crayons (") and "one of the things that stain?" in q for q in asked)
+    assert not any("one of the none?" in q or "one of the N/A?" in q for q in asked)
+    assert prompts.is_no_name("None") and prompts.is_no_name("no material") and not prompts.is_no_name("nonstick pans")
+    with pytest.raises(GiftError, match="rungs"):
+        GiftProbKernel(rungs="depth")
+    with pytest.raises(ValueError, match="handled object"):
+        prompts.facet_messages([], ["banana"])

@@ -237,6 +237,7 @@ CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
+RUNGS = ("breadth", "facets")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -302,7 +303,7 @@ class GiftProbKernel(RelevanceKernel):
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
-                 ladder: str | None = None) -> None:
+                 ladder: str | None = None, rungs: str = "breadth") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -336,7 +337,13 @@ class GiftProbKernel(RelevanceKernel):
         #: gift-dev2 and lm-dev: mean train-calibrated F1 0.764 -> 0.808 with cut_prior=1); ``"always"``;
         #: ``"never"`` (the default with a calibration).
         self.ladder_mode = ladder
-        self._ladder_memo: dict[tuple, tuple[str, ...]] = {}
+        if rungs not in RUNGS:
+            raise GiftError(f"gift-prob: rungs must be one of {RUNGS}, got {rungs!r}")
+        #: What the ladder's rungs are: ``"breadth"`` (the default), one kind named narrow, middle and broad;
+        #: ``"facets"``, the kind, the material and a property the demonstrated objects share, each possibly
+        #: none (:func:`gift_kernels.prompts.facet_messages`). Measured in docs/results/front_half.md, section 11.
+        self.rungs = rungs
+        self._ladder_memo: dict[tuple, dict[str, str]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
             raise GiftError(f"gift-prob: cut_prior must be in [0, 1], got {cut_prior!r}")
         #: Weight of the scale's own boundary, 1/2 (the scene's mean combined z-score; for ``combine="none"``
@@ -380,7 +387,7 @@ class GiftProbKernel(RelevanceKernel):
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
-                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r})")
+                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -461,9 +468,14 @@ class GiftProbKernel(RelevanceKernel):
         return cat
 
     def ladder(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> tuple[str, ...]:
-        """Names, narrow to broad, of what the ``handled`` training objects share that the ``left_alone``
-        ones do not (one greedy call per pair of lists, no goal text; duplicates dropped). An answer with no
-        usable name gives ``()``, with a warning."""
+        """Names of what the ``handled`` training objects share that the ``left_alone`` ones do not: narrow to
+        broad (``rungs="breadth"``) or kind, material, property (``"facets"``); one greedy call per pair of
+        lists, no goal text; duplicates and "none" dropped. An answer with no usable name gives ``()``, with a
+        warning."""
+        return tuple(self._ladder_levels(handled, left_alone).values())
+
+    def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> dict[str, str]:
+        """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` or ``FACET_LEVELS``), levels without a name left out."""
         key = (tuple(handled), tuple(left_alone))
         with self._lock:
             if key in self._ladder_memo:
@@ -471,23 +483,25 @@ class GiftProbKernel(RelevanceKernel):
         from gift_llm.structured import ask_dict
 
         self.calls += 1
-        levels = prompts.LADDER_LEVELS
+        facets = self.rungs == "facets"
+        levels = prompts.FACET_LEVELS if facets else prompts.LADDER_LEVELS
+        msgs = (prompts.facet_messages if facets else prompts.ladder_messages)(handled, left_alone)
         try:
-            ans = ask_dict(self.lm, prompts.ladder_messages(handled, left_alone), temperature=0.0, max_tokens=96,
+            ans = ask_dict(self.lm, msgs, temperature=0.0, max_tokens=96,
                            json_schema=schemas.ladder_schema(levels) if self.constrained else None,
                            required_keys=levels)
         except LMAnswerError as e:
             warnings.warn(f"gift-prob: the LM named no category ladder for {', '.join(handled)} (answer "
                           f"{e.raw[:80]!r}); using the goal's category alone", stacklevel=2)
             ans = {}
-        names: list[str] = []
+        names: dict[str, str] = {}
         for lv in levels:
             cat = prompts.parse_category(ans[lv]) if isinstance(ans.get(lv), str) else None
-            if cat and cat.lower() not in [n.lower() for n in names]:
-                names.append(cat)
+            if cat and not prompts.is_no_name(cat) and cat.lower() not in [n.lower() for n in names.values()]:
+                names[lv] = cat
         with self._lock:
-            self._ladder_memo[key] = tuple(names)
-        return tuple(names)
+            self._ladder_memo[key] = names
+        return names
 
     def _uses_ladder(self, intent: Intent) -> bool:
         return self.ladder_mode == "always" or (self.ladder_mode == "inferred" and intent.source == "inferred")
@@ -498,14 +512,19 @@ class GiftProbKernel(RelevanceKernel):
         goal's category) and of each rung's log-odds; a training object's rungs are named without it
         (leave-one-out; with no relevant partner left, the full ladder, as in :meth:`_categories`)."""
         handled, alone = self._split(train, rel)
-        full = self.ladder(handled, alone)
+        levels = self._ladder_levels(handled, alone)
+        full = tuple(levels.values())
         if not full:
             return lo
-        loo = []  # per training object, its ladder named without it (a shorter one repeats its last rung)
+        loo = []  # per training object, its ladder named without it
         for o in train:
             h = [n for n in handled if n != o.name]
-            own = (self.ladder(h, [n for n in alone if n != o.name]) if h else full) or full
-            loo.append([own[min(r, len(own) - 1)] for r in range(len(full))])
+            if self.rungs == "facets":  # the same facet; the full ladder's name where it names none
+                own_lv = self._ladder_levels(h, [n for n in alone if n != o.name]) if h else levels
+                loo.append([own_lv.get(lv, levels[lv]) for lv in levels])
+            else:  # breadth: the same position; a shorter ladder repeats its last rung
+                own = (self.ladder(h, [n for n in alone if n != o.name]) if h else full) or full
+                loo.append([own[min(r, len(own) - 1)] for r in range(len(full))])
         rungs = [self.log_odds(list(test) + list(train), intent, [name] * len(test) + [lad[r] for lad in loo])
                  for r, name in enumerate(full)]
         details["ladder"] = {"categories": list(full), "goal": lo.tolist(),

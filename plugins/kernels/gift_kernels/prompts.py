@@ -254,6 +254,56 @@ def ladder_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[
     return tuple(msgs)
 
 
+#: The facets of the faceted ladder (:func:`facet_messages`): what kind of thing, what it is made of, a trait.
+FACET_LEVELS: tuple[str, ...] = ("kind", "material", "property")
+
+FACET_SYSTEM = ("You say what a set of household objects have in common that the other objects do not, in three "
+                'ways: "kind" (what sort of thing they are or what they are used for), "material" (what they are '
+                'mostly made of) and "property" (a trait they share, such as how they behave or what care they '
+                'need). Each is a short plural noun phrase, never one object\'s name, or "none" when the objects '
+                "share nothing of that sort or the other objects share it too. Reply with one JSON object and "
+                'nothing else: {"kind": "...", "material": "...", "property": "..."}')
+
+#: Worked examples of the faceted ladder, written before any faceted run: the four sets of
+#: :data:`LADDER_EXAMPLES` and two more (no object and no goal word of any shipped suite; checked by a test).
+#: Most facets are "none": the answer names only what the sets share.
+FACET_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, str]], ...] = (
+    (("aquarium net", "fish food flakes"), ("tripod", "kettle"),
+     ("aquarium supplies", "none", "things for keeping fish")),
+    (("bamboo steamer basket", "bamboo back scratcher"), ("steel colander", "plastic back massager"),
+     ("none", "bamboo things", "none")),
+    (("bag of marbles", "box of push pins"), ("beach ball", "floor cushion"),
+     ("small loose pieces", "none", "choking hazards")),
+    (("cork notice board", "cork yoga block"), ("foam yoga mat", "glass pitcher"),
+     ("none", "cork things", "light things that float")),
+    (("ice pack", "bag of frozen peas"), ("bread roll", "oven mitt"),
+     ("freezer things", "none", "cold things")),
+    (("party hat", "confetti cannon"), ("tire gauge", "bath mat"),
+     ("party supplies", "none", "things for celebrations")),
+)
+
+
+def facet_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+    """Ask for the kind, the material and a property that the ``handled`` training objects share and the
+    ``left_alone`` ones do not, each possibly "none" (no goal text)."""
+    if not handled:
+        raise ValueError("facet_messages needs at least one handled object")
+    msgs = [Message("system", FACET_SYSTEM)]
+    for h, a, names in FACET_EXAMPLES:
+        msgs += [Message("user", _ladder_question(h, a)),
+                 Message("assistant", json.dumps(dict(zip(FACET_LEVELS, names))))]
+    msgs.append(Message("user", _ladder_question(handled, left_alone)))
+    return tuple(msgs)
+
+
+_NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
+
+
+def is_no_name(name: str) -> bool:
+    """Whether a ladder answer says the objects share nothing at that level ("none", "n/a", ...)."""
+    return bool(_NO_NAME.match(name.strip()))
+
+
 def parse_category(answer: str, max_words: int = 8) -> str | None:
     """The noun phrase of a category answer (first line, quotes, a leading "the" and end punctuation
     removed), or ``None`` when there is none or it is longer than ``max_words`` words."""
