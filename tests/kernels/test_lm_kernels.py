@@ -641,3 +641,23 @@ def test_gift_prob_faceted_ladder_drops_none_and_matches_each_training_objects_r
         GiftProbKernel(rungs="depth")
     with pytest.raises(ValueError, match="handled object"):
         prompts.facet_messages([], ["banana"])
+
+
+def test_gift_prob_both_ladders_average_the_breadth_and_the_facet_rungs_without_repeats():
+    """rungs="both": one breadth and one facet call per ladder; their rungs, a name given twice once."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
+        if messages[0].content == prompts.FACET_SYSTEM:
+            return json.dumps({"kind": "Art supplies", "material": "none", "property": "things that stain"})
+        return category_json("fruit")
+
+    lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", rungs="both")
+    rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+    assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things",
+                                                  "things that stain"]
+    assert len(rs.details["ladder"]["terms"]) == 4
+    systems = [c[0][0].content for c in lm.calls]
+    assert systems.count(prompts.LADDER_SYSTEM) == systems.count(prompts.FACET_SYSTEM) == 1 + len(TRAIN)

@@ -237,7 +237,7 @@ CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
-RUNGS = ("breadth", "facets")
+RUNGS = ("breadth", "facets", "both")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -341,7 +341,8 @@ class GiftProbKernel(RelevanceKernel):
             raise GiftError(f"gift-prob: rungs must be one of {RUNGS}, got {rungs!r}")
         #: What the ladder's rungs are: ``"breadth"`` (the default), one kind named narrow, middle and broad;
         #: ``"facets"``, the kind, the material and a property the demonstrated objects share, each possibly
-        #: none (:func:`gift_kernels.prompts.facet_messages`). Measured in docs/results/front_half.md, section 11.
+        #: none (:func:`gift_kernels.prompts.facet_messages`); ``"both"``: the rungs of the two (two calls per
+        #: ladder). Measured in docs/results/front_half.md, section 11.
         self.rungs = rungs
         self._ladder_memo: dict[tuple, dict[str, str]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
@@ -475,15 +476,26 @@ class GiftProbKernel(RelevanceKernel):
         return tuple(self._ladder_levels(handled, left_alone).values())
 
     def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> dict[str, str]:
-        """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` or ``FACET_LEVELS``), levels without a name left out."""
-        key = (tuple(handled), tuple(left_alone))
+        """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` and/or ``FACET_LEVELS``, as ``rungs`` says), levels
+        without a name, or repeating an earlier level's name, left out."""
+        kinds = {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets")}[self.rungs]
+        names: dict[str, str] = {}
+        for kind in kinds:
+            for lv, cat in self._ask_ladder(kind, handled, left_alone).items():
+                if cat.lower() not in [n.lower() for n in names.values()]:
+                    names[lv] = cat
+        return names
+
+    def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str]) -> dict[str, str]:
+        """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels."""
+        key = (kind, tuple(handled), tuple(left_alone))
         with self._lock:
             if key in self._ladder_memo:
                 return self._ladder_memo[key]
         from gift_llm.structured import ask_dict
 
         self.calls += 1
-        facets = self.rungs == "facets"
+        facets = kind == "facets"
         levels = prompts.FACET_LEVELS if facets else prompts.LADDER_LEVELS
         msgs = (prompts.facet_messages if facets else prompts.ladder_messages)(handled, left_alone)
         try:
@@ -492,7 +504,7 @@ class GiftProbKernel(RelevanceKernel):
                            required_keys=levels)
         except LMAnswerError as e:
             warnings.warn(f"gift-prob: the LM named no category ladder for {', '.join(handled)} (answer "
-                          f"{e.raw[:80]!r}); using the goal's category alone", stacklevel=2)
+                          f"{e.raw[:80]!r}); using the goal's category alone", stacklevel=3)
             ans = {}
         names: dict[str, str] = {}
         for lv in levels:
@@ -519,7 +531,7 @@ class GiftProbKernel(RelevanceKernel):
         loo = []  # per training object, its ladder named without it
         for o in train:
             h = [n for n in handled if n != o.name]
-            if self.rungs == "facets":  # the same facet; the full ladder's name where it names none
+            if self.rungs != "breadth":  # the same level; the full ladder's name where it names none
                 own_lv = self._ladder_levels(h, [n for n in alone if n != o.name]) if h else levels
                 loo.append([own_lv.get(lv, levels[lv]) for lv in levels])
             else:  # breadth: the same position; a shorter ladder repeats its last rung
