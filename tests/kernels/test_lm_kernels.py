@@ -539,7 +539,7 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
 
     lm = ScriptedLM(answer=answer, probs=probs)
     inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
-    k = GiftProbKernel(lm=lm, combine="none", ladder="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", ladder="inferred", rungs="breadth")
     rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
     assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things"]
     ladders = [c[0][-1].content for c in lm.calls if c[0][0].content == prompts.LADDER_SYSTEM]
@@ -567,6 +567,7 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
         GiftProbKernel(ladder="inferred", calibration="pooled")
     # the default: the ladder for inferred intents, none with a calibration (fitted on one category's log-odds)
     assert GiftProbKernel().ladder_mode == "inferred" and GiftProbKernel(calibration="pooled").ladder_mode == "never"
+    assert GiftProbKernel().rungs == "both"  # breadth and facets (front_half.md, section 11)
     with pytest.raises(ValueError, match="handled object"):
         prompts.ladder_messages([], ["banana"])
 

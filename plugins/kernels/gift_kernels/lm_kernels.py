@@ -287,11 +287,13 @@ class GiftProbKernel(RelevanceKernel):
     the goal and the demonstrated training objects when ``relevant_train`` is given; ``"goal"``: from the
     goal alone), ``cut_prior`` (weight of the scores' own boundary 1/2 against the leave-one-out cut in the
     train-calibrated threshold; 0: the leave-one-out cut alone; default 1, the boundary alone), ``ladder``
-    (``"inferred"``, the default: for an intent inferred from demonstrations, also name three categories,
-    narrow to broad, from the demonstrated objects alone and average the z-scored log-odds under all four;
+    (``"inferred"``, the default: for an intent inferred from demonstrations, also name categories from the
+    demonstrated objects alone, the rungs, and average the z-scored log-odds under them and the goal's;
     the scene under each category alone is reported as an intent candidate that answers can pick, see
-    :mod:`gift.core.queries`; ``"always"``; ``"never"``, the default with a ``calibration``). Both defaults
-    were chosen on the three development suites, docs/results/front_half.md.
+    :mod:`gift.core.queries`; ``"always"``; ``"never"``, the default with a ``calibration``), ``rungs``
+    (``"both"``, the default: the ladder's rungs are three breadths of one kind and, from a second call, the
+    kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``). The
+    defaults were chosen on the three development suites, docs/results/front_half.md (sections 10, 11).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -303,7 +305,7 @@ class GiftProbKernel(RelevanceKernel):
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
-                 ladder: str | None = None, rungs: str = "breadth") -> None:
+                 ladder: str | None = None, rungs: str = "both") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -339,10 +341,12 @@ class GiftProbKernel(RelevanceKernel):
         self.ladder_mode = ladder
         if rungs not in RUNGS:
             raise GiftError(f"gift-prob: rungs must be one of {RUNGS}, got {rungs!r}")
-        #: What the ladder's rungs are: ``"breadth"`` (the default), one kind named narrow, middle and broad;
+        #: What the ladder's rungs are: ``"breadth"``, one kind named narrow, middle and broad;
         #: ``"facets"``, the kind, the material and a property the demonstrated objects share, each possibly
-        #: none (:func:`gift_kernels.prompts.facet_messages`); ``"both"``: the rungs of the two (two calls per
-        #: ladder). Measured in docs/results/front_half.md, section 11.
+        #: none (:func:`gift_kernels.prompts.facet_messages`); ``"both"``, the default: the rungs of the two
+        #: (two calls per ladder). Chosen on gift-dev, gift-dev2 and lm-dev by a rule written before the runs
+        #: (mean inferred train-calibrated F1 0.808 -> 0.813, no suite loses; facets alone lose 0.029 on
+        #: gift-dev2); docs/results/front_half.md, section 11.
         self.rungs = rungs
         self._ladder_memo: dict[tuple, dict[str, str]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
@@ -710,8 +714,8 @@ class GiftProbKernel(RelevanceKernel):
         ladder is named again with the test objects answered "yes" beside the demonstrated ones and those
         answered "no" beside the left-alone ones, every object is asked about the new rungs, and the LM term
         is the mean of the z-scored log-odds under the goal's category (unchanged) and the new rungs; then
-        the terms are combined as in :meth:`score`. Cost: one ladder call and ``n_test + n_train`` yes/no
-        questions per rung. The training objects are asked about the new rungs as named with them (not held
+        the terms are combined as in :meth:`score`. Cost: a ladder call (two with ``rungs="both"``) and
+        ``n_test + n_train`` yes/no questions per rung. The training objects are asked about the new rungs as named with them (not held
         out: an answer adds test objects to the evidence, and naming the rungs once per training object would
         cost a ladder call each). None when the scene does not use the ladder (``ladder="never"``, or a
         ground-truth intent with ``"inferred"``) or the LM names no rung: answers then only re-threshold.
