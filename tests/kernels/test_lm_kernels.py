@@ -427,7 +427,8 @@ def test_gift_prob_ladder_on_the_embedded_model_names_the_class_a_generic_inferr
     """lm-dev's protect_electronics (a development suite) with the generic goal Call 1 of the 1.5B model wrote
     for it. Measured (docs/results/front_half.md): the goal's category ("objects to carry") ranks the test
     objects at LM-only AUC 0.64; the ladder's rungs, named from the laptop and the phone, at 0.96. The
-    ladder's rungs also come back as intent candidates for the questions of gift.core.queries."""
+    ladder's rungs (three breadths and the facets that are not "none" or a repeat) also come back as intent
+    candidates for the questions of gift.core.queries."""
     from gift.core.alignment import score_alignment
     from gift.core.metrics import roc_auc
     from gift.core.queries import QueryProblem
@@ -443,7 +444,7 @@ def test_gift_prob_ladder_on_the_embedded_model_names_the_class_a_generic_inferr
     k = GiftProbKernel(lm=embedded_lm)  # the default: the ladder for an inferred intent
     sc = score_alignment(k, test, train, intent, relevant_train=spec.relevant_train)
     rungs = [c.lower() for c in sc.details["ladder"]["categories"]]
-    assert 2 <= len(rungs) <= 3 and not any(o in c for c in rungs for o in ("laptop", "phone")), rungs
+    assert 2 <= len(rungs) <= 6 and not any(o in c for c in rungs for o in ("laptop", "phone")), rungs
     assert any(w in " ".join(rungs) for w in ("electronic", "digital", "device", "comput", "gadget")), rungs
     lm_ladder = np.asarray(sc.details["terms"]["lm"]["test"])
     assert roc_auc(lm_ladder, labels) >= 0.85 and roc_auc(lm_ladder, labels) > roc_auc(plain.relevance, labels) + 0.1
@@ -559,7 +560,7 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
     # a stated intent: no ladder; ladder="always" asks it for a stated intent too; bad option named
     stated = GiftProbKernel(lm=lm, combine="none", ladder="inferred").score(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
     assert "ladder" not in stated.details
-    assert "ladder" in GiftProbKernel(lm=lm, combine="none", ladder="always").score(
+    assert "ladder" in GiftProbKernel(lm=lm, combine="none", ladder="always", rungs="breadth").score(
         TEST, TRAIN, ART, ("paintbrush", "sketchbook")).details
     with pytest.raises(GiftError, match="ladder"):
         GiftProbKernel(ladder="sometimes")

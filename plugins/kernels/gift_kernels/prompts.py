@@ -244,12 +244,21 @@ def _ladder_question(handled: Sequence[str], left_alone: Sequence[str]) -> str:
 def ladder_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
     """Ask for three names, narrow to broad, of what the ``handled`` training objects share that the
     ``left_alone`` ones do not (no goal text: the question a small model answers best)."""
+    return _shared_names_messages("ladder_messages", LADDER_SYSTEM, LADDER_LEVELS, LADDER_EXAMPLES, handled,
+                                  left_alone)
+
+
+def _shared_names_messages(caller: str, system: str, levels: Sequence[str],
+                           examples: Sequence[tuple[Sequence[str], Sequence[str], Sequence[str]]],
+                           handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+    """A few-shot conversation asking what ``handled`` objects share that ``left_alone`` ones do not, answered
+    with one name per level (the worked ``examples`` as JSON answers)."""
     if not handled:
-        raise ValueError("ladder_messages needs at least one handled object")
-    msgs = [Message("system", LADDER_SYSTEM)]
-    for h, a, names in LADDER_EXAMPLES:
+        raise ValueError(f"{caller} needs at least one handled object")
+    msgs = [Message("system", system)]
+    for h, a, names in examples:
         msgs += [Message("user", _ladder_question(h, a)),
-                 Message("assistant", json.dumps(dict(zip(LADDER_LEVELS, names))))]
+                 Message("assistant", json.dumps(dict(zip(levels, names))))]
     msgs.append(Message("user", _ladder_question(handled, left_alone)))
     return tuple(msgs)
 
@@ -264,8 +273,8 @@ FACET_SYSTEM = ("You say what a set of household objects have in common that the
                 "share nothing of that sort or the other objects share it too. Reply with one JSON object and "
                 'nothing else: {"kind": "...", "material": "...", "property": "..."}')
 
-#: Worked examples of the faceted ladder, written before any faceted run: the four sets of
-#: :data:`LADDER_EXAMPLES` and two more (no object and no goal word of any shipped suite; checked by a test).
+#: Worked examples of the faceted ladder, written before any faceted run: three sets of
+#: :data:`LADDER_EXAMPLES` and three more (no object and no goal word of any shipped suite; checked by a test).
 #: Most facets are "none": the answer names only what the sets share.
 FACET_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, str]], ...] = (
     (("aquarium net", "fish food flakes"), ("tripod", "kettle"),
@@ -286,14 +295,8 @@ FACET_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, st
 def facet_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
     """Ask for the kind, the material and a property that the ``handled`` training objects share and the
     ``left_alone`` ones do not, each possibly "none" (no goal text)."""
-    if not handled:
-        raise ValueError("facet_messages needs at least one handled object")
-    msgs = [Message("system", FACET_SYSTEM)]
-    for h, a, names in FACET_EXAMPLES:
-        msgs += [Message("user", _ladder_question(h, a)),
-                 Message("assistant", json.dumps(dict(zip(FACET_LEVELS, names))))]
-    msgs.append(Message("user", _ladder_question(handled, left_alone)))
-    return tuple(msgs)
+    return _shared_names_messages("facet_messages", FACET_SYSTEM, FACET_LEVELS, FACET_EXAMPLES, handled,
+                                  left_alone)
 
 
 _NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
