@@ -212,7 +212,7 @@ def write(result: dict, md: Path) -> None:
                      f"{f1:.3f}, {'met' if f1 >= 0.90 else 'not met'}.")
     else:
         lines.append("- Target 1 (inferred intents, `gift-paper`, at most 2 questions per intent: F1 >= 0.90): not "
-                     "measured in this version (ground-truth intents only); `--intent-sources inferred` measures it.")
+                     "measured by this run (it has no `gift-paper` run with inferred intents).")
     lines += ["- Target 2 (the best policy needs at most half the questions random needs for the same F1): the "
               "ratios in each suite's table below; 0.5 or less meets it.",
               *(["- The rule by which answers move the cut was changed once, after the first `gift-paper` run: the "
