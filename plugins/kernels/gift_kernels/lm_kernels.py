@@ -482,13 +482,15 @@ class GiftProbKernel(RelevanceKernel):
     def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> dict[str, str]:
         """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` and/or ``FACET_LEVELS``, as ``rungs`` says), levels
         without a name, or repeating an earlier level's name, left out."""
-        kinds = {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets")}[self.rungs]
         names: dict[str, str] = {}
-        for kind in kinds:
+        for kind in self._ladder_kinds():
             for lv, cat in self._ask_ladder(kind, handled, left_alone).items():
                 if cat.lower() not in [n.lower() for n in names.values()]:
                     names[lv] = cat
         return names
+
+    def _ladder_kinds(self) -> tuple[str, ...]:
+        return {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets")}[self.rungs]
 
     def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str]) -> dict[str, str]:
         """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels."""
@@ -528,6 +530,14 @@ class GiftProbKernel(RelevanceKernel):
         goal's category) and of each rung's log-odds; a training object's rungs are named without it
         (leave-one-out; with no relevant partner left, the full ladder, as in :meth:`_categories`)."""
         handled, alone = self._split(train, rel)
+        # every call of one kind before the other's: consecutive calls with the same system message and worked
+        # examples reuse them from llama.cpp's KV cache (the answers depend on the prompt alone)
+        sets = [(handled, alone)] + [([n for n in handled if n != o.name], [n for n in alone if n != o.name])
+                                     for o in train]
+        for kind in self._ladder_kinds():
+            for h, a in sets:
+                if h:
+                    self._ask_ladder(kind, h, a)
         levels = self._ladder_levels(handled, alone)
         full = tuple(levels.values())
         if not full:
