@@ -515,7 +515,7 @@ class GiftProbKernel(RelevanceKernel):
         names: dict[str, str] = {}
         for lv in levels:
             cat = prompts.parse_category(ans[lv]) if isinstance(ans.get(lv), str) else None
-            if cat and not prompts.is_no_name(cat) and cat.lower() not in [n.lower() for n in names.values()]:
+            if cat and not prompts.is_no_name(cat):  # repeats are dropped by _ladder_levels
                 names[lv] = cat
         with self._lock:
             self._ladder_memo[key] = names
@@ -543,13 +543,12 @@ class GiftProbKernel(RelevanceKernel):
         if not full:
             return lo
         loo = []  # per training object, its ladder named without it
-        for o in train:
-            h = [n for n in handled if n != o.name]
+        for h, a in sets[1:]:
             if self.rungs != "breadth":  # the same level; the full ladder's name where it names none
-                own_lv = self._ladder_levels(h, [n for n in alone if n != o.name]) if h else levels
+                own_lv = self._ladder_levels(h, a) if h else levels
                 loo.append([own_lv.get(lv, levels[lv]) for lv in levels])
             else:  # breadth: the same position; a shorter ladder repeats its last rung
-                own = (self.ladder(h, [n for n in alone if n != o.name]) if h else full) or full
+                own = (self.ladder(h, a) if h else full) or full
                 loo.append([own[min(r, len(own) - 1)] for r in range(len(full))])
         rungs = [self.log_odds(list(test) + list(train), intent, [name] * len(test) + [lad[r] for lad in loo])
                  for r, name in enumerate(full)]
@@ -725,9 +724,9 @@ class GiftProbKernel(RelevanceKernel):
         answered "no" beside the left-alone ones, every object is asked about the new rungs, and the LM term
         is the mean of the z-scored log-odds under the goal's category (unchanged) and the new rungs; then
         the terms are combined as in :meth:`score`. Cost: a ladder call (two with ``rungs="both"``) and
-        ``n_test + n_train`` yes/no questions per rung. The training objects are asked about the new rungs as named with them (not held
-        out: an answer adds test objects to the evidence, and naming the rungs once per training object would
-        cost a ladder call each). None when the scene does not use the ladder (``ladder="never"``, or a
+        ``n_test + n_train`` yes/no questions per rung. The training objects are asked about the new rungs as
+        named with them (not held out: an answer adds test objects to the evidence, and naming the rungs once
+        per training object would cost a ladder call each). None when the scene does not use the ladder (``ladder="never"``, or a
         ground-truth intent with ``"inferred"``) or the LM names no rung: answers then only re-threshold.
         ``details["ladder"]["answers"]`` lists the answers used."""
         test, train = list(test), list(train)
