@@ -33,7 +33,10 @@ def probe(path: str) -> dict[str, float]:
     res = json.loads(Path(path).read_text(encoding="utf-8"))
     suite = load_suite(res["suite_path"] or res["suite"])
     out: dict[str, list[float]] = {"goal": [], "mean": [], "weighted": [], "kept": []}
-    for intent_id, rec in res["kernels"]["gift-prob"]["intents"].items():
+    names = [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"]
+    if len(names) != 1:
+        raise SystemExit(f"{path}: expected one gift-prob kernel (any options), found {sorted(res['kernels'])}")
+    for intent_id, rec in res["kernels"][names[0]]["intents"].items():
         ladder = rec["details"].get("ladder")
         if not ladder:
             continue

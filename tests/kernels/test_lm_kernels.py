@@ -663,3 +663,45 @@ def test_gift_prob_both_ladders_average_the_breadth_and_the_facet_rungs_without_
     assert len(rs.details["ladder"]["terms"]) == 4
     systems = [c[0][0].content for c in lm.calls]
     assert systems.count(prompts.LADDER_SYSTEM) == systems.count(prompts.FACET_SYSTEM) == 1 + len(TRAIN)
+
+
+@pytest.mark.parametrize("check", ["fit", "weight"])
+def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_objects_it_was_named_from(check):
+    """check="fit" / "weight": the goal's category and every rung are asked of the training objects as named
+    (in-sample); a category whose answers invert the demonstrated objects (the goal's "fruit") gets no weight,
+    "fit" keeps only the categories that put every demonstrated object above every left-alone one, "weight"
+    weighs each by AUC - 1/2. The LM term is the weighted mean of the z-scored log-odds."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "painting tools": {"paintbrush": 0.9},
+           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
+           "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
+
+    def probs(text):
+        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        p = yes.get(cat, {}).get(name, 0.3)
+        return {"yes": p, "no": 1.0 - p}
+
+    lm = ScriptedLM(answer=answer, probs=probs)
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    rs = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check=check).score(TEST, TRAIN, inferred,
+                                                                                  ("paintbrush", "sketchbook"))
+    lad = rs.details["ladder"]
+    # in-sample AUC on the training objects: fruit ranks the banana first, painting tools ties the sketchbook with
+    # the left-alone objects
+    assert lad["check"]["in_sample_auc"] == [0.25, 0.75, 1.0, 1.0]
+    expected = {"fit": [0.0, 0.0, 0.5, 0.5], "weight": [0.0, 0.25 / 1.25, 0.5 / 1.25, 0.5 / 1.25]}[check]
+    assert np.allclose(lad["check"]["weights"], expected)
+    views = [np.asarray(lad["goal"])] + [np.asarray(t["test"] + t["train"]) for t in lad["terms"]]
+    z = [(v - v.mean()) / v.std() for v in views]
+    lo = sum(w * v for w, v in zip(expected, z))
+    assert np.allclose(rs.relevance, 1.0 / (1.0 + np.exp(-lo[: len(TEST)])))
+    # the full rungs were asked of the training objects (the paintbrush's own rungs are named without it)
+    asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
+    assert any(q.startswith("Is a paintbrush (a brush for paint) one of the painting tools?") for q in asked)
+    assert GiftProbKernel().check == "none"  # the default (front_half.md, section 12)
+    with pytest.raises(GiftError, match="check"):
+        GiftProbKernel(check="vote")

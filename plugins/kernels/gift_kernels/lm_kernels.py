@@ -238,6 +238,7 @@ CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
 RUNGS = ("breadth", "facets", "both")
+CHECK = ("none", "fit", "weight")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -292,8 +293,11 @@ class GiftProbKernel(RelevanceKernel):
     the scene under each category alone is reported as an intent candidate that answers can pick, see
     :mod:`gift.core.queries`; ``"always"``; ``"never"``, the default with a ``calibration``), ``rungs``
     (``"both"``, the default: the ladder's rungs are three breadths of one kind and, from a second call, the
-    kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``). The
-    defaults were chosen on the three development suites, docs/results/front_half.md (sections 10, 11).
+    kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``), ``check``
+    (``"none"``, the default: the ladder's categories are averaged as they are; ``"fit"`` / ``"weight"``: each
+    is first asked of the training objects as named and kept only if it puts every demonstrated object above
+    every left-alone one / weighted by its AUC - 1/2 there). The defaults were chosen on the three development
+    suites, docs/results/front_half.md (sections 10-12).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -305,7 +309,7 @@ class GiftProbKernel(RelevanceKernel):
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
-                 ladder: str | None = None, rungs: str = "both") -> None:
+                 ladder: str | None = None, rungs: str = "both", check: str = "none") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -348,6 +352,16 @@ class GiftProbKernel(RelevanceKernel):
         #: (mean inferred train-calibrated F1 0.808 -> 0.813, no suite loses; facets alone lose 0.029 on
         #: gift-dev2); docs/results/front_half.md, section 11.
         self.rungs = rungs
+        if check not in CHECK:
+            raise GiftError(f"gift-prob: check must be one of {CHECK}, got {check!r}")
+        #: How the ladder's categories (the goal's and each rung) are checked against the training objects they
+        #: were named from before they are averaged: each is asked of every training object as named (in-sample)
+        #: and scored by its AUC separating the demonstrated objects from the left-alone ones. ``"none"``: the
+        #: plain mean of all; ``"fit"``: the mean of those with AUC 1 (else those with the best AUC);
+        #: ``"weight"``: weights ``max(AUC - 1/2, 0)`` (all zero: the plain mean). Costs ``n_train`` yes/no
+        #: questions per category. Not the default: "fit" lifted gift-dev and gift-dev2 but lost 0.04 F1 on lm-dev
+        #: (front_half.md, section 12).
+        self.check = check
         self._ladder_memo: dict[tuple, dict[str, str]] = {}
         if not 0.0 <= float(cut_prior) <= 1.0:
             raise GiftError(f"gift-prob: cut_prior must be in [0, 1], got {cut_prior!r}")
@@ -392,7 +406,7 @@ class GiftProbKernel(RelevanceKernel):
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
-                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r})")
+                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -555,7 +569,32 @@ class GiftProbKernel(RelevanceKernel):
         details["ladder"] = {"categories": list(full), "goal": lo.tolist(),
                              "terms": [{"test": v[: len(test)].tolist(), "train": v[len(test):].tolist()}
                                        for v in rungs]}
-        return np.mean([_zscore(v) for v in [lo, *rungs]], axis=0)
+        views = [_zscore(v) for v in [lo, *rungs]]
+        if self.check == "none":
+            return np.mean(views, axis=0)
+        weights = self._check_weights(train, intent, rel, [details.get("category"), *full], details["ladder"])
+        return np.tensordot(weights, np.stack(views), axes=1) / weights.sum()
+
+    def _check_weights(self, train: Sequence[ObjectSpec], intent: Intent, rel: np.ndarray,
+                       categories: Sequence[str | None], record: dict[str, Any]) -> np.ndarray:
+        """``[n_categories]`` weights of the ladder's categories (``check``), from each category's in-sample AUC
+        on the training objects (``rel`` ``[n_train]``: demonstrated or not); recorded in ``record["check"]``."""
+        from gift.core.metrics import roc_auc
+
+        aucs = np.array([roc_auc(self.log_odds(train, intent, [c] * len(train)), rel) if c is not None
+                         and rel.any() and (~rel).any() else float("nan") for c in categories])
+        known = ~np.isnan(aucs)
+        weights = np.ones(len(categories))
+        if known.any():
+            if self.check == "fit":
+                top = 1.0 if (aucs[known] >= 1.0 - 1e-12).any() else aucs[known].max()
+                weights = (known & (np.nan_to_num(aucs, nan=-1.0) >= top - 1e-12)).astype(float)
+            else:
+                sep = np.clip(np.nan_to_num(aucs, nan=0.5) - 0.5, 0.0, None)
+                weights = sep if sep.sum() > 0 else weights
+        record["check"] = {"mode": self.check, "in_sample_auc": [None if np.isnan(a) else float(a) for a in aucs],
+                           "weights": (weights / weights.sum()).tolist()}
+        return weights
 
     def log_odds(self, objects: Sequence[ObjectSpec], intent: Intent,
                  categories: Sequence[str] | None = None) -> np.ndarray:
