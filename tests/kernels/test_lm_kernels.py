@@ -147,6 +147,15 @@ def _probs_by_name(table):
     return probs
 
 
+def _probs_by_category(table, default):
+    """P(yes) of "Is a <object> (...) one of the <category>?" from ``table[category][object]``, else ``default``."""
+    def probs(text):
+        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        p = table.get(cat, {}).get(name, default)
+        return {"yes": p, "no": 1.0 - p}
+    return probs
+
+
 def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
              "toothbrush": 0.4, "apple": 0.05}
@@ -533,12 +542,7 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
     yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.8, "crayons": 0.8}}
 
-    def probs(text):
-        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
-        p = yes.get(cat, {}).get(name, 0.3)
-        return {"yes": p, "no": 1.0 - p}
-
-    lm = ScriptedLM(answer=answer, probs=probs)
+    lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
     inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
     k = GiftProbKernel(lm=lm, combine="none", ladder="inferred", rungs="breadth")
     rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
@@ -680,12 +684,7 @@ def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_o
            "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
 
-    def probs(text):
-        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
-        p = yes.get(cat, {}).get(name, 0.3)
-        return {"yes": p, "no": 1.0 - p}
-
-    lm = ScriptedLM(answer=answer, probs=probs)
+    lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
     inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
     rs = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check=check).score(TEST, TRAIN, inferred,
                                                                                   ("paintbrush", "sketchbook"))
