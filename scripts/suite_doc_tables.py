@@ -17,6 +17,8 @@ DEV_LABEL = {"cloth_items": "d1a", "breakables": "d1b", "leather_goods": "d2a", 
              "toiletries": "d3a", "sewing_supplies": "d3b", "baking_tools": "d4a", "gardening_supplies": "d4b"}
 DEV2_LABEL = {"musical_instruments": "e1a", "houseplants": "e1b", "metal_things": "e2a", "toys": "e2b",
               "dog_things": "e3a", "fishing_tackle": "e3b", "hair_accessories": "e4a", "candles": "e4b"}
+DEV3_LABEL = {"eyewear": "f1a", "timepieces": "f1b", "rubber_things": "f2a", "spices": "f2b",
+              "swimming_kit": "f3a", "camping_gear": "f3b", "batteries": "f4a", "coins": "f4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -66,15 +68,19 @@ def catalog_size(doc: str, name: str, n: int) -> str:
 def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
     paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
+    dev3 = gift.load_suite("gift-dev3")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
     doc = put(doc, "gift-dev:intents", intent_tables(dev, DEV_LABEL))
     doc = put(doc, "gift-dev2:summary", summary(dev2, DEV2_LABEL, "label"))
     doc = put(doc, "gift-dev2:intents", intent_tables(dev2, DEV2_LABEL))
+    doc = put(doc, "gift-dev3:summary", summary(dev3, DEV3_LABEL, "label"))
+    doc = put(doc, "gift-dev3:intents", intent_tables(dev3, DEV3_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
     doc = catalog_size(doc, "gift-dev", len(dev.objects))
     doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
+    doc = catalog_size(doc, "gift-dev3", len(dev3.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

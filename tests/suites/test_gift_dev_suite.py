@@ -1,4 +1,4 @@
-"""The shipped development suites ``gift-dev`` and ``gift-dev2``: new intents and objects, none borrowed from
+"""The shipped development suites ``gift-dev``, ``gift-dev2`` and ``gift-dev3``: new intents and objects, none borrowed from
 the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
@@ -40,6 +40,13 @@ DEV_SUITES = {
                      ("dog_things", "fishing_tackle"), ("hair_accessories", "candles")],
         "label_words": r"instrument|music|plant|metal|\btoy|plaything|\bdog|canine|puppy|fish|tackle"
                        r"|\bangl(?:er|ing)|accessor|candle",
+    },
+    "gift-dev3": {
+        "siblings": [("eyewear", "timepieces"), ("rubber_things", "spices"),
+                     ("swimming_kit", "camping_gear"), ("batteries", "coins")],
+        "label_words": r"eyewear|\bglasses|spectacle|goggle|\blens|sunglass|clock|\bwatch|timepiece|\btime\b"
+                       r"|rubber|latex|spice|season|swim|\bpool|bathing|\bcamp|\btent\b|batter|\bvolt"
+                       r"|coin|currency|money|cash|penny|pence|\bcents?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
