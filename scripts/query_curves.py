@@ -129,6 +129,18 @@ def figure_dir(md: Path) -> str:
     return "queries" if md.stem == "queries" else md.stem
 
 
+def provenance(result: dict) -> str:
+    """Commit and code version of the run, or of each merged part in the order of the commands."""
+    def one(r: dict) -> str:
+        git = r.get("git") or {}
+        return (f"commit `{(git.get('commit') or '?')[:10]}`{' (dirty)' if git.get('dirty') else ''}, code version "
+                f"`{(r.get('code_version') or '?')[:12]}`")
+    parts = result.get("parts") or []
+    if len(parts) < 2:
+        return one(result)[0].upper() + one(result)[1:]
+    return "Merged from runs at " + "; ".join(f"{one(p)} ({p.get('seconds') or 0:.0f} s)" for p in parts)
+
+
 def write(result: dict, md: Path) -> None:
     from gift.core.serialization import write_json
     from gift_experiments import query_curves as qc
@@ -144,7 +156,6 @@ def write(result: dict, md: Path) -> None:
         figures[source] = qc.figure(runs, fig_dir / f"{source}.png",
                                     title=f"{next(iter(runs.values()))['kernel']}, {source} intents: "
                                           f"F1 and win rate after k questions per intent")
-    git = result.get("git") or {}
     lm = result.get("lm") or {}
     kernel = result.get("kernel", "gift-prob")
     recipe = ("`gift-prob` with its default recipe at the commit below, the one measured in "
@@ -176,8 +187,7 @@ def write(result: dict, md: Path) -> None:
                  "ladder again); each suite's table also gives the same sessions without it."
                  if result.get("rescore") else ""), "",
              "Command:", "", "```", result["command"], "```", "",
-             f"Commit `{(git.get('commit') or '?')[:10]}`{' (dirty)' if git.get('dirty') else ''}, code version "
-             f"`{result.get('code_version', '?')[:12]}`, LM `{lm.get('identity', '–')}` (model sha256 "
+             provenance(result) + f", LM `{lm.get('identity', '–')}` (model sha256 "
              f"`{(lm.get('model_sha256') or '–')[:12]}`), {result['seconds']:.0f} s. Suites: " +
              ", ".join(f"`{n}` (sha256 `{(p.get('sha256') or '?')[:12]}`)" for n, p in result["suites"].items()) +
              f". Every number is in [`{sub}/curves.json`]({sub}/curves.json).", ""]

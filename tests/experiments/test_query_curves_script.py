@@ -1,0 +1,40 @@
+"""scripts/query_curves.py --from-json: one page from runs made in separate processes keeps every run's
+commit and code version (the page's provenance line names each part)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "query_curves.py"
+
+
+@pytest.fixture(scope="module")
+def script():
+    spec = importlib.util.spec_from_file_location("query_curves_script", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _run(commit: str, version: str, suite: str, seconds: float) -> dict:
+    return {"kernel": "gift-prob", "rescore": False, "random_seeds": 3, "lm": {"model_sha256": "abc"},
+            "command": f"python scripts/query_curves.py --suites {suite}", "git": {"commit": commit, "dirty": False},
+            "code_version": version, "seconds": seconds, "suites": {suite: {"sha256": "0" * 64}},
+            "runs": {f"{suite} | inferred": {}}, "failures": []}
+
+
+def test_a_merged_page_names_the_commit_and_code_version_of_each_part(script):
+    merged = script.merge([_run("a" * 40, "1" * 16, "s1", 600.0), _run("b" * 40, "2" * 16, "s2", 40.0)])
+    assert set(merged["runs"]) == {"s1 | inferred", "s2 | inferred"} and merged["seconds"] == 640.0
+    line = script.provenance(merged)
+    assert line.startswith("Merged from runs at commit `aaaaaaaaaa`, code version `111111111111` (600 s)")
+    assert "commit `bbbbbbbbbb`, code version `222222222222` (40 s)" in line
+    # one run: its own commit, as before
+    assert script.provenance(_run("c" * 40, "3" * 16, "s3", 1.0)) == "Commit `cccccccccc`, code version `333333333333`"
+    other = _run("d" * 40, "4" * 16, "s4", 1.0)
+    other["lm"] = {"model_sha256": "other"}
+    with pytest.raises(SystemExit, match="different LM model files"):
+        script.merge([_run("a" * 40, "1" * 16, "s1", 1.0), other])
