@@ -110,12 +110,20 @@ def merge_lm(parts: Sequence[dict[str, Any] | None]) -> dict[str, Any] | None:
     return merged
 
 
+def source_at_start() -> dict[str, Any]:
+    """The git commit and code version of the code that runs, taken when a run starts (a commit made while
+    it runs must not be recorded as what made it)."""
+    return {"git": git_commit(), "code_version": code_version()}
+
+
 def run_record(*, options: Mapping[str, Any], suite: Suite, lm: dict[str, Any] | None,
                executor: Mapping[str, Any], started: float, seconds: float,
-               recovered: Sequence[str] = ()) -> dict[str, Any]:
-    """What made one run (or one resume) of a study: code, environment, suite, LM, options."""
+               recovered: Sequence[str] = (), source: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """What made one run (or one resume) of a study: code (``source``, from :func:`source_at_start` when the
+    run started), environment, suite, LM, options."""
+    source = source_at_start() if source is None else source
     rec: dict[str, Any] = {"started": time.strftime("%Y-%m-%dT%H:%M:%S", time.localtime(started)),
-                           "seconds": round(seconds, 2), "git": git_commit(), "code_version": code_version(),
+                           "seconds": round(seconds, 2), "git": source["git"], "code_version": source["code_version"],
                            "python": platform.python_version(), "platform": platform.platform(),
                            "versions": versions(), "suite": suite_provenance(suite), "options": dict(options),
                            "executor": dict(executor)}
@@ -172,7 +180,7 @@ def run_study(cfg: StudyConfig, out: Path | str | None, progress: Progress | Non
     ``previous``: run records of earlier runs into the same results (resumes), kept in the manifest.
     """
     progress = progress or Progress()
-    started, t0 = time.time(), time.perf_counter()
+    started, t0, source = time.time(), time.perf_counter(), source_at_start()
     suite = load_suite(cfg.suite)
     intents = [suite.intent(i) for i in cfg.intents] if cfg.intents else list(suite.intents)
     out_dir = None if out is None else str(Path(out).resolve())
@@ -208,7 +216,7 @@ def run_study(cfg: StudyConfig, out: Path | str | None, progress: Progress | Non
             timing[stage] = timing.get(stage, 0.0) + sec
     results["timing"] = timing
     record = run_record(options=attrs.asdict(cfg), suite=suite, lm=merge_lm([p["lm"] for p in slices]),
-                        executor=where, started=started, seconds=time.perf_counter() - t0,
+                        executor=where, started=started, seconds=time.perf_counter() - t0, source=source,
                         recovered=[f for p in slices for f in p.get("recovered", [])])
     results["manifest"] = manifest([*previous, record], cfg.key())
     return results
@@ -478,7 +486,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     labels, and the abstention band (:func:`~gift.study.chain.query_stage`); results under ``queries``;
     ``query_rescore``: the kernel scores the scene again with the answers when it can (rule 5).
     """
-    started, t0 = time.time(), time.perf_counter()
+    started, t0, source = time.time(), time.perf_counter(), source_at_start()
     if isinstance(suite, str):
         suite = load_suite(suite)
     bad = [t for t in thresholds if t not in THRESHOLDS]
@@ -511,7 +519,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
         lm_parts = _run_items(ex, table, cfg, suite, kernels, specs, out_dir, echo)
         where = {"name": ex.name, "max_workers": ex.max_workers}
     record = run_record(options=attrs.asdict(cfg), suite=suite, lm=merge_lm(lm_parts), executor=where,
-                        started=started, seconds=time.perf_counter() - t0)
+                        started=started, seconds=time.perf_counter() - t0, source=source)
     out["manifest"] = manifest([record], cfg.key())
     if checkpoint:
         checkpoint(out)
