@@ -704,3 +704,32 @@ def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_o
     assert GiftProbKernel().check == "none"  # the default (front_half.md, section 12)
     with pytest.raises(GiftError, match="check"):
         GiftProbKernel(check="vote")
+
+
+def test_gift_prob_answers_re_weigh_the_re_named_rungs_by_the_same_check():
+    """score_with_answers with check="fit": the rungs named again with the answered test objects are weighed
+    exactly as in score (the goal's inverted "fruit" gets no weight), and the check is recorded."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            if "crayons" in messages[-1].content:  # named again with the answer "crayons: yes"
+                return json.dumps({"narrow": "coloring tools", "middle": "art supplies", "broad": "none"})
+            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "painting tools": {"paintbrush": 0.9},
+           "coloring tools": {"paintbrush": 0.8, "crayons": 0.9, "sketchbook": 0.4},
+           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
+           "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
+    lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit")
+    rs = k.score_with_answers(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"), {"crayons": True})
+    lad = rs.details["ladder"]
+    assert lad["categories"] == ["coloring tools", "art supplies"]
+    # in-sample AUC of fruit, coloring tools, art supplies on the training objects (paintbrush, sketchbook relevant)
+    assert lad["check"]["in_sample_auc"] == [0.25, 1.0, 1.0]
+    assert np.allclose(lad["check"]["weights"], [0.0, 0.5, 0.5])
+    views = [np.asarray(lad["goal"])] + [np.asarray(t["test"] + t["train"]) for t in lad["terms"]]
+    z = [(v - v.mean()) / v.std() for v in views]
+    lo = 0.5 * z[1] + 0.5 * z[2]
+    assert np.allclose(rs.relevance, 1.0 / (1.0 + np.exp(-lo[: len(TEST)])))

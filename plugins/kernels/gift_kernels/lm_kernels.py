@@ -569,11 +569,18 @@ class GiftProbKernel(RelevanceKernel):
         details["ladder"] = {"categories": list(full), "goal": lo.tolist(),
                              "terms": [{"test": v[: len(test)].tolist(), "train": v[len(test):].tolist()}
                                        for v in rungs]}
-        views = [_zscore(v) for v in [lo, *rungs]]
+        return self._mix_views(train, intent, rel, [lo, *rungs], [details.get("category"), *full], details["ladder"])
+
+    def _mix_views(self, train: Sequence[ObjectSpec], intent: Intent, rel: np.ndarray, views: Sequence[np.ndarray],
+                   categories: Sequence[str | None], record: dict[str, Any]) -> np.ndarray:
+        """The LM term ``[n_test + n_train]``: the z-scored log-odds ``views`` (one per category: the goal's,
+        then each rung's) averaged, with ``check`` weighted by :meth:`_check_weights`. The one place where the
+        ladder's categories are weighed, used by :meth:`score` and :meth:`score_with_answers`."""
+        z = np.stack([_zscore(v) for v in views])
         if self.check == "none":
-            return np.mean(views, axis=0)
-        weights = self._check_weights(train, intent, rel, [details.get("category"), *full], details["ladder"])
-        return np.tensordot(weights, np.stack(views), axes=1) / weights.sum()
+            return z.mean(axis=0)
+        weights = self._check_weights(train, intent, rel, categories, record)
+        return np.tensordot(weights, z, axes=1) / weights.sum()
 
     def _check_weights(self, train: Sequence[ObjectSpec], intent: Intent, rel: np.ndarray,
                        categories: Sequence[str | None], record: dict[str, Any]) -> np.ndarray:
@@ -793,7 +800,7 @@ class GiftProbKernel(RelevanceKernel):
                                        for v in terms],
                              "answers": {"yes": yes, "no": no}, "train_held_out": False,
                              "categories_before": list(lad["categories"])}
-        lo = np.mean([_zscore(v) for v in [goal, *terms]], axis=0)
+        lo = self._mix_views(train, intent, rel, [goal, *terms], [details.get("category"), *rungs], details["ladder"])
         return self._finish(test, train, rel, lo, details)
 
     def _finish(self, test: list[ObjectSpec], train: list[ObjectSpec], rel: np.ndarray, lo: np.ndarray,
