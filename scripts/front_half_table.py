@@ -6,6 +6,9 @@ runs only), gift-prob's category, its F1 with the train-calibrated and the oracl
 best label-free surface baseline's train-calibrated F1; then the pooled rows per kernel.
 
     python scripts/front_half_table.py out/r16b/gift-paper-inferred.json out/r16b/gift-paper-ground-truth.json
+
+With ``--pool``: one table of every kernel's F1 pooled over all the files' intents together (true positives,
+false positives and false negatives summed over every test object), per cut, and each file's commit.
 """
 
 from __future__ import annotations
@@ -70,13 +73,38 @@ def table(path: str, extra: Sequence[str] = ()) -> str:
     return "\n".join(lines)
 
 
+def pooled(paths: Sequence[str]) -> str:
+    """Markdown: per kernel present in every file, F1 with each cut pooled over all the files' intents, from the
+    ``overall`` counts of ``all`` (so each test object counts once, whatever its suite)."""
+    runs = [json.loads(Path(p).read_text(encoding="utf-8")) for p in paths]
+    kernels = [k for k in runs[0]["kernels"] if all(k in r["kernels"] for r in runs)]
+    lines = ["| kernel | " + " | ".join(f"F1 {c} (pooled)" for c in (TC, OR)) + " | intents |",
+             "|---|" + "---|" * 3]
+    for k in kernels:
+        cells = []
+        for cut in (TC, OR):
+            tp = fp = fn = 0
+            for r in runs:
+                a = r["kernels"][k]["overall"][cut]["all"]
+                tp, fp, fn = tp + a["tp"], fp + a["fp"], fn + a["fn"]
+            cells.append(f"{2 * tp / (2 * tp + fp + fn):.3f}" if tp else "0.000")
+        n = sum(len(r["kernels"][k]["intents"]) for r in runs)
+        lines.append(f"| {k} | " + " | ".join(cells) + f" | {n} |")
+    lines.append("")
+    lines += [f"- `{Path(p).name}`: {r['suite']}, {r['intent_source']}, commit "
+              f"`{r['manifest']['git']['commit'][:7]}`{' (dirty)' if r['manifest']['git']['dirty'] else ''}"
+              for p, r in zip(paths, runs)]
+    return "\n".join(lines)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("results", nargs="+")
     p.add_argument("--with", dest="extra", nargs="*", default=[],
                    help="results of the same suite and intent source whose baseline kernels join the table")
+    p.add_argument("--pool", action="store_true", help="one table of F1 pooled over all the files' intents")
     args = p.parse_args(argv)
-    print("\n\n".join(table(r, args.extra) for r in args.results))
+    print(pooled(args.results) if args.pool else "\n\n".join(table(r, args.extra) for r in args.results))
     return 0
 
 
