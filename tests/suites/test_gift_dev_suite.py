@@ -1,5 +1,5 @@
-"""The shipped development suites ``gift-dev``, ``gift-dev2`` and ``gift-dev3``: new intents and objects, none borrowed from
-the suites they are checked against.
+"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3`` and ``gift-dev4``: new intents and
+objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -47,6 +47,14 @@ DEV_SUITES = {
         "label_words": r"eyewear|\bglasses|spectacle|goggle|\blens|sunglass|clock|\bwatch|timepiece|\btime\b"
                        r"|rubber|latex|spice|season|swim|\bpool|bathing|\bcamp|\btent\b|batter|\bvolt"
                        r"|coin|currency|money|cash|penny|pence|\bcents?\b",
+    },
+    "gift-dev4": {
+        "siblings": [("headwear", "feathered_things"), ("stone_things", "fasteners"),
+                     ("baby_things", "cleaning_supplies"), ("keys", "measuring_tools")],
+        "label_words": r"\bhats?\b|\bcaps?\b|headwear|headgear|millin|feather|plum(?:e|age)|\bquills?\b"
+                       r"|stone|\brocks?\b|granite|marble|fasten|screw|\bnuts?\b|\bbolts?\b"
+                       r"|\bbab(?:y|ies)|infant|newborn|toddler|clean|\bwash|scrub|\bdirt|grime|disinfect|detergent"
+                       r"|\bkeys?\b|keyring|keychain|keyhole|\blocks?\b|\bunlock|locksmith|measur|\bgauges?\b|calibrat",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
