@@ -20,7 +20,7 @@ DEV2_LABEL = {"musical_instruments": "e1a", "houseplants": "e1b", "metal_things"
 DEV3_LABEL = {"eyewear": "f1a", "timepieces": "f1b", "rubber_things": "f2a", "spices": "f2b",
               "swimming_kit": "f3a", "camping_gear": "f3b", "batteries": "f4a", "coins": "f4b"}
 DEV4_LABEL = {"headwear": "g1a", "feathered_things": "g1b", "stone_things": "g2a", "fasteners": "g2b",
-              "baby_things": "g3a", "cleaning_supplies": "g3b", "keys": "g4a", "measuring_tools": "g4b"}
+              "baby_things": "g3a", "gym_kit": "g3b", "keys": "g4a", "measuring_tools": "g4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:

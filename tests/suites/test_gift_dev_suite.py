@@ -50,10 +50,10 @@ DEV_SUITES = {
     },
     "gift-dev4": {
         "siblings": [("headwear", "feathered_things"), ("stone_things", "fasteners"),
-                     ("baby_things", "cleaning_supplies"), ("keys", "measuring_tools")],
+                     ("baby_things", "gym_kit"), ("keys", "measuring_tools")],
         "label_words": r"\bhats?\b|\bcaps?\b|headwear|headgear|millin|feather|plum(?:e|age)|\bquills?\b"
                        r"|stone|\brocks?\b|granite|marble|fasten|screw|\bnuts?\b|\bbolts?\b"
-                       r"|\bbab(?:y|ies)|infant|newborn|toddler|clean|\bwash|scrub|\bdirt|grime|disinfect|detergent"
+                       r"|\bbab(?:y|ies)|infant|newborn|toddler|\bgym|workout|exercis|fitness|cardio|\bweights?\b|\blift(?:ing)?\b|dumbbell|barbell"
                        r"|\bkeys?\b|keyring|keychain|keyhole|\blocks?\b|\bunlock|locksmith|measur|\bgauges?\b|calibrat",
     },
 }
