@@ -701,7 +701,7 @@ def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_o
     # the full rungs were asked of the training objects (the paintbrush's own rungs are named without it)
     asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
     assert any(q.startswith("Is a paintbrush (a brush for paint) one of the painting tools?") for q in asked)
-    assert GiftProbKernel().check == "none"  # the default (front_half.md, section 12)
+    assert GiftProbKernel().check == "fit"  # the default (front_half.md, section 14)
     with pytest.raises(GiftError, match="check"):
         GiftProbKernel(check="vote")
 
