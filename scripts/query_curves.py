@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> dict:
             if not data:
                 continue
             sim = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid, policies=args.policies,
-                              rescore=args.rescore)
+                              rescore=args.rescore, move=args.move)
             if args.rescore:  # the same sessions with answers that only re-threshold, for the comparison
                 sim["without_rescore"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
                                                      policies=args.policies, bands=())["curves"]
@@ -96,6 +96,7 @@ def run(args: argparse.Namespace) -> dict:
     out["lm"] = lm_inputs(comp) if comp is not None and comp.lm_built else None
     out["random_seeds"] = args.random_seeds
     out["rescore"] = bool(args.rescore)
+    out["move"] = args.move
     out["seconds"] = round(time.perf_counter() - t_all, 1)
     return out
 
@@ -324,6 +325,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default="docs/results/queries.md")
     p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
     p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
+    p.add_argument("--move", default="nearest", choices=("nearest", "widest", "answers"),
+                   help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
     p.add_argument("--rescore", action="store_true",
                    help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "
                         "the curves without it are kept next to them")

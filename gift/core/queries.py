@@ -106,8 +106,9 @@ UNKNOWN = ("?", "dont know", "don't know", "unknown", "skip")
 
 #: Name of the kernel's own intent among the candidates (:meth:`QueryProblem.of`).
 PRIMARY = "primary"
-#: How answers move the train-calibrated cut (rule 2): ``nearest`` (adopted), ``widest`` (measured, dropped).
-MOVES = ("nearest", "widest")
+#: How answers move the train-calibrated cut (rule 2): ``nearest`` (adopted), ``widest`` (measured, dropped),
+#: ``answers`` (the cut without answers moved only as far as the answers alone require).
+MOVES = ("nearest", "widest", "answers")
 
 
 # ============================================================================= answers
@@ -386,15 +387,18 @@ def belief(decision: np.ndarray, cut: float) -> np.ndarray:
 
 def nearest_best_cut(positives: Sequence[float], negatives: Sequence[float], anchor: float,
                      scene: Sequence[float]) -> float:
-    """Among the cuts with the highest balanced accuracy on ``positives`` / ``negatives``, the one nearest
-    ``anchor`` (``anchor`` itself when it is among them). Candidates: midpoints between neighbouring values
+    """Among the cuts with the highest balanced accuracy on ``positives`` / ``negatives`` (either may be empty,
+    not both), the one nearest ``anchor`` (``anchor`` itself when it is among them). Candidates: midpoints between neighbouring values
     of the labelled points and the ``scene``'s other scores, points just outside their range, the anchor."""
     p, n = np.asarray(positives, dtype=float), np.asarray(negatives, dtype=float)
-    if p.size == 0 or n.size == 0:
-        raise GiftError("nearest_best_cut needs at least one positive and one negative score")
+    if p.size == 0 and n.size == 0:
+        raise GiftError("nearest_best_cut needs at least one positive or negative score")
     values = np.unique(np.concatenate([p, n, np.asarray(scene, dtype=float)]))
     cands = np.concatenate([[values[0] - 1e-6], (values[:-1] + values[1:]) / 2, [values[-1] + 1e-6], [anchor]])
-    bacc = ((p[None, :] >= cands[:, None]).mean(axis=1) + (n[None, :] < cands[:, None]).mean(axis=1)) / 2
+    # balanced accuracy over the classes present (one class alone: its accuracy)
+    parts = [(p[None, :] >= cands[:, None]).mean(axis=1)] if p.size else []
+    parts += [(n[None, :] < cands[:, None]).mean(axis=1)] if n.size else []
+    bacc = np.mean(parts, axis=0)
     ok = cands[bacc >= bacc.max() - 1e-12]
     return float(ok[np.argmin(np.abs(ok - anchor))])
 
@@ -402,7 +406,9 @@ def nearest_best_cut(positives: Sequence[float], negatives: Sequence[float], anc
 def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequence[Answer],
                  test_labels: Mapping[str, bool] | None = None, move: str = "nearest") -> tuple[float, str]:
     """``(cut, note)`` of ``strategy`` with the answers as extra labelled points (rule 2 of the module);
-    ``move``: ``"nearest"`` (the adopted rule) or ``"widest"`` (the widest-gap midpoint, as without answers)."""
+    ``move``: ``"nearest"`` (the adopted rule), ``"widest"`` (the widest-gap midpoint, as without answers) or
+    ``"answers"`` (the nearest cut to the one without answers among those that best separate the answers alone:
+    the training evidence and any prior cut stay as they were weighed without answers)."""
     if move not in MOVES:
         raise GiftError(f"unknown cut move {move!r}; one of {MOVES}")
     if strategy != "train-calibrated":
@@ -415,6 +421,12 @@ def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequen
     yes, no = [v for v in yes if v > NEVER], [v for v in no if v > NEVER]
     if not yes and not no:
         return scores.threshold("train-calibrated")
+    if move == "answers":  # the cut without answers already holds the training evidence and the prior
+        anchor, note = scores.threshold("train-calibrated")
+        scene = scores.decision[scores.decision > NEVER]
+        cut = nearest_best_cut(yes, no, anchor, scene)
+        return float(np.clip(cut, 0.0, 1.0)), (f"{note}; moved only as far as {len(yes)} yes / {len(no)} no "
+                                               f"answers require")
     pos = neg = np.zeros(0)
     if scores.relevant_train and scores.loo_scores is not None:
         usable = scores.loo_scores > NEVER
