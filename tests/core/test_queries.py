@@ -111,6 +111,21 @@ def test_the_cut_moves_only_as_far_as_the_answers_require():
         QueryProblem.of(s, move="far")
 
 
+def test_move_answers_keeps_the_cut_without_answers_and_moves_it_only_for_answers_it_gets_wrong():
+    """move="answers": the anchor is the cut without answers (its training evidence and prior as they were);
+    only the answers decide whether and how far it moves, one class of answers being enough."""
+    s = scores_of(test_r={"x": 0.7, "y": 0.6, "z": 0.65, "w": 0.1}, train_r={"a": 0.8, "b": 0.78, "c": 0.3, "d": 0.2})
+    problem = QueryProblem.of(s, move="answers")
+    assert resolve(problem, [Answer("x", True), Answer("w", False)]).cut == pytest.approx(0.54)  # both right
+    assert resolve(problem, [Answer("y", False)]).cut == pytest.approx(0.625)  # just past the "no", below z
+    # a "yes" far below: the answers alone pull the cut just under it (the training evidence, which "nearest"
+    # weighs again, would keep it at 0.54)
+    low_yes = resolve(problem, [Answer("w", True)])
+    assert low_yes.cut == pytest.approx(0.1, abs=1e-5) and low_yes.predicted.tolist() == [True, True, True, True]
+    assert resolve(QueryProblem.of(s), [Answer("w", True)]).cut == pytest.approx(0.54)
+    assert "moved only as far as 1 yes / 0 no answers require" in low_yes.note
+
+
 def test_answers_do_not_move_fixed_or_non_oracle_cuts_but_still_fix_the_answered_objects():
     s = scores_of()
     for strategy in (0.5, "non-oracle"):
