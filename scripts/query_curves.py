@@ -325,7 +325,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default="docs/results/queries.md")
     p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
     p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
-    p.add_argument("--move", default="nearest", choices=("nearest", "widest", "answers"),
+    from gift.core.queries import MOVES
+
+    p.add_argument("--move", default="nearest", choices=MOVES,
                    help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
     p.add_argument("--rescore", action="store_true",
                    help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "

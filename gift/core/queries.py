@@ -388,8 +388,9 @@ def belief(decision: np.ndarray, cut: float) -> np.ndarray:
 def nearest_best_cut(positives: Sequence[float], negatives: Sequence[float], anchor: float,
                      scene: Sequence[float]) -> float:
     """Among the cuts with the highest balanced accuracy on ``positives`` / ``negatives`` (either may be empty,
-    not both), the one nearest ``anchor`` (``anchor`` itself when it is among them). Candidates: midpoints between neighbouring values
-    of the labelled points and the ``scene``'s other scores, points just outside their range, the anchor."""
+    not both), the one nearest ``anchor`` (``anchor`` itself when it is among them). Candidates: midpoints
+    between neighbouring values of the labelled points and the ``scene``'s other scores, points just outside
+    their range, the anchor."""
     p, n = np.asarray(positives, dtype=float), np.asarray(negatives, dtype=float)
     if p.size == 0 and n.size == 0:
         raise GiftError("nearest_best_cut needs at least one positive or negative score")
