@@ -43,7 +43,9 @@ How answers update the scene (the rule)
    answers alone place the cut as soon as they hold both a "yes" and a "no"; until then the strategy's
    own fallback stands. A ``fixed``, ``non-oracle`` or ``oracle`` cut is not moved by answers (only the
    answered objects change): ``non-oracle`` is a mean over training pairs with no labels to add to, and
-   the other two are given.
+   the other two are given. Other moves (``move=``, :data:`MOVES`): ``"answers"`` moves the cut without
+   answers only as far as the answers alone require; ``"stay"`` never moves it (answers only fix the answered
+   objects); both are measured in docs/results/queries.md.
 3. **Answers choose among intent candidates.** With several candidates, each one is charged the number
    of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
    fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
@@ -107,8 +109,9 @@ UNKNOWN = ("?", "dont know", "don't know", "unknown", "skip")
 #: Name of the kernel's own intent among the candidates (:meth:`QueryProblem.of`).
 PRIMARY = "primary"
 #: How answers move the train-calibrated cut (rule 2): ``nearest`` (adopted), ``widest`` (measured, dropped),
-#: ``answers`` (the cut without answers moved only as far as the answers alone require).
-MOVES = ("nearest", "widest", "answers")
+#: ``answers`` (the cut without answers moved only as far as the answers alone require), ``stay`` (answers never
+#: move the cut; they only fix the answered objects).
+MOVES = ("nearest", "widest", "answers", "stay")
 
 
 # ============================================================================= answers
@@ -407,9 +410,10 @@ def nearest_best_cut(positives: Sequence[float], negatives: Sequence[float], anc
 def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequence[Answer],
                  test_labels: Mapping[str, bool] | None = None, move: str = "nearest") -> tuple[float, str]:
     """``(cut, note)`` of ``strategy`` with the answers as extra labelled points (rule 2 of the module);
-    ``move``: ``"nearest"`` (the adopted rule), ``"widest"`` (the widest-gap midpoint, as without answers) or
+    ``move``: ``"nearest"`` (the adopted rule), ``"widest"`` (the widest-gap midpoint, as without answers),
     ``"answers"`` (the nearest cut to the one without answers among those that best separate the answers alone:
-    the training evidence and any prior cut stay as they were weighed without answers)."""
+    the training evidence and any prior cut stay as they were weighed without answers) or ``"stay"`` (the cut
+    without answers: answers only fix the answered objects)."""
     if move not in MOVES:
         raise GiftError(f"unknown cut move {move!r}; one of {MOVES}")
     if strategy != "train-calibrated":
@@ -422,6 +426,9 @@ def answered_cut(scores: AlignmentScores, strategy: str | float, answers: Sequen
     yes, no = [v for v in yes if v > NEVER], [v for v in no if v > NEVER]
     if not yes and not no:
         return scores.threshold("train-calibrated")
+    if move == "stay":  # the cut without answers, whatever they say (rule 1 still fixes the answered objects)
+        cut, note = scores.threshold("train-calibrated")
+        return cut, f"{note}; not moved by the {len(yes)} yes / {len(no)} no answers (move='stay')"
     if move == "answers":  # the cut without answers already holds the training evidence and the prior
         anchor, note = scores.threshold("train-calibrated")
         scene = scores.decision[scores.decision > NEVER]

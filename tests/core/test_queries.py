@@ -126,6 +126,18 @@ def test_move_answers_keeps_the_cut_without_answers_and_moves_it_only_for_answer
     assert "moved only as far as 1 yes / 0 no answers require" in low_yes.note
 
 
+def test_move_stay_keeps_the_cut_without_answers_and_only_fixes_the_answered_objects():
+    s = scores_of(test_r={"x": 0.7, "y": 0.6, "z": 0.65, "w": 0.1}, train_r={"a": 0.8, "b": 0.78, "c": 0.3, "d": 0.2})
+    problem = QueryProblem.of(s, move="stay")
+    cut0 = s.threshold("train-calibrated")[0]
+    st = resolve(problem, [Answer("y", False), Answer("w", True)])  # both wrong at the cut without answers
+    assert st.cut == pytest.approx(cut0) and "not moved by the 1 yes / 1 no answers" in st.note
+    assert st.predicted.tolist() == [True, False, True, True]  # y and w fixed, x and z as without answers
+    assert st.alignment.target("y") == DISTRACTOR and st.alignment.scores["w"] == 1.0
+    # with the same answers, "nearest" lifts the cut just past the "no" at 0.6
+    assert resolve(QueryProblem.of(s), [Answer("y", False)]).cut > 0.6 > cut0
+
+
 def test_answers_do_not_move_fixed_or_non_oracle_cuts_but_still_fix_the_answered_objects():
     s = scores_of()
     for strategy in (0.5, "non-oracle"):

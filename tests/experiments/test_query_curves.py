@@ -54,6 +54,26 @@ def test_every_policy_at_every_k_with_random_over_seeds_and_abstention():
     assert t["best"] in qc.POLICIES and [r["k"] for r in t["rows"]] == [1, 2, 4]
 
 
+def _wrong(state, labels):
+    return int(sum(state.predicted[i] != labels[t] for i, t in enumerate(state.test)))
+
+
+def test_the_ceiling_asks_the_best_two_questions_and_no_policy_gets_fewer_wrong_decisions():
+    sim = qc.simulate(DATA, random_seeds=3, bands=())
+    b = sim["bound"]
+    # one: y (fp) and z (fn) are the wrong ones; two: p (fp) and r (fn); answering them leaves nothing wrong
+    assert b["k"] == 2 and b["f1"] == 1.0
+    assert sorted(b["asked"]["one"]) == ["y", "z"] and sorted(b["asked"]["two"]) == ["p", "r"]
+    k2 = sim["grid"].index(2)
+    for policy in qc.POLICIES:
+        for d in DATA:
+            st = qc.session(d, policy, grid=(2,))[0]
+            best, _ = qc.best_questions(d, 2)
+            assert _wrong(best, d.labels) <= _wrong(st, d.labels)
+        assert sim["curves"][policy]["f1"][k2] <= b["f1"]
+    assert qc.simulate(DATA, random_seeds=1, bands=(), grid=(0, 1))["bound"] is None  # no k = 2 in the grid
+
+
 def test_questions_random_needs_are_interpolated_on_the_grid():
     grid = [0, 1, 2, 4, 8]
     assert qc.queries_to_reach(grid, [0.5, 0.6, 0.7, 0.9, 1.0], 0.8) == pytest.approx(3.0)

@@ -13,6 +13,7 @@ reports: ``figure(json.load(open("curves.json"))["runs"], path)``).
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -23,7 +24,7 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import QueryProblem, QueryState, asking, labels_answerer
+from gift.core.queries import Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
 
 log = logging.getLogger("gift.query_curves")
 
@@ -135,13 +136,32 @@ def _aggregate(per_intent: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
             "abstained": int(sum(o["abstained"] for o in per_intent.values()))}
 
 
+def best_questions(data: IntentData, k: int = 2, move: str = "nearest") -> tuple[QueryState, dict[str, Any]]:
+    """The ceiling of any policy: the ``k`` questions, chosen with the labels among all sets of ``k`` test
+    objects, after whose answers (rules 1-3 of :mod:`gift.core.queries`, no re-scoring) the scene has the fewest
+    wrong decisions (fp + fn; ties: more tp, then the first set in scene order). Per intent no policy gets fewer
+    wrong decisions with ``k`` questions; pooled F1 is not separable over intents, so it is the ceiling of F1 up to
+    that. Returns the state and its :func:`outcome`."""
+    problem = QueryProblem.of(data.scores, THRESHOLD, move=move)
+    y = np.array([data.labels[t] for t in problem.test])
+    best, best_value = None, None
+    for chosen in itertools.combinations(problem.test, min(k, len(problem.test))):
+        state = resolve(problem, [Answer(o, bool(data.labels[o])) for o in chosen])
+        m = binary_metrics(state.predicted, y)
+        value = (-(m.fp + m.fn), m.tp)
+        if best_value is None or value > best_value:
+            best, best_value = state, value
+    return best, outcome(data, best)
+
+
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
              bands: Sequence[float] = BANDS, move: str = "nearest", rescore: bool = False,
              policies: Sequence[str] = POLICIES) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
     the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run. Returns
-    ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention"}``."""
+    ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
+    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy), None with ``rescore`` or without 2 in the grid."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
     for policy in tuple(policies) + (BASELINE,):
@@ -173,11 +193,17 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
         for d in data:
             last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
+    bound = None
+    if 2 in grid and not rescore:  # what any policy could reach with 2 questions (answers only re-threshold)
+        found = {d.intent: best_questions(d, 2, move) for d in data}
+        bound = {"k": 2, **_aggregate({i: o for i, (_, o) in found.items()}),
+                 "asked": {i: [a.object for a in st.answers] for i, (st, _) in found.items()}}
     abstention = {}
     for band in bands:
         outs = {d.intent: outcome(d, session(d, policies[0], 0, band, grid=(0,), move=move)[0]) for d in data}
         abstention[str(band)] = _aggregate(outs)
-    return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention}
+    return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention,
+            "bound": bound}
 
 
 def queries_to_reach(grid: Sequence[int], values: Sequence[float | None], target: float) -> float | None:
