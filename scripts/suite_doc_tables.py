@@ -21,6 +21,8 @@ DEV3_LABEL = {"eyewear": "f1a", "timepieces": "f1b", "rubber_things": "f2a", "sp
               "swimming_kit": "f3a", "camping_gear": "f3b", "batteries": "f4a", "coins": "f4b"}
 DEV4_LABEL = {"headwear": "g1a", "feathered_things": "g1b", "stone_things": "g2a", "fasteners": "g2b",
               "baby_things": "g3a", "gym_kit": "g3b", "keys": "g4a", "measuring_tools": "g4b"}
+DEV5_LABEL = {"mirrored_things": "h1a", "chocolate": "h1b", "seashells": "h2a", "cordage": "h2b",
+              "footwear": "h3a", "magic_props": "h3b", "cutlery": "h4a", "adhesives": "h4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -70,7 +72,7 @@ def catalog_size(doc: str, name: str, n: int) -> str:
 def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
     paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
-    dev3, dev4 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4")
+    dev3, dev4, dev5 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4"), gift.load_suite("gift-dev5")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
@@ -81,11 +83,14 @@ def main() -> None:
     doc = put(doc, "gift-dev3:intents", intent_tables(dev3, DEV3_LABEL))
     doc = put(doc, "gift-dev4:summary", summary(dev4, DEV4_LABEL, "label"))
     doc = put(doc, "gift-dev4:intents", intent_tables(dev4, DEV4_LABEL))
+    doc = put(doc, "gift-dev5:summary", summary(dev5, DEV5_LABEL, "label"))
+    doc = put(doc, "gift-dev5:intents", intent_tables(dev5, DEV5_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
     doc = catalog_size(doc, "gift-dev", len(dev.objects))
     doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
     doc = catalog_size(doc, "gift-dev3", len(dev3.objects))
     doc = catalog_size(doc, "gift-dev4", len(dev4.objects))
+    doc = catalog_size(doc, "gift-dev5", len(dev5.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

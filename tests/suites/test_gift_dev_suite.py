@@ -1,5 +1,5 @@
-"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3`` and ``gift-dev4``: new intents and
-objects, none borrowed from the suites they are checked against.
+"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4`` and ``gift-dev5``: new
+intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -55,6 +55,16 @@ DEV_SUITES = {
                        r"|stone|\brocks?\b|granite|marble|fasten|screw|\bnuts?\b|\bbolts?\b"
                        r"|\bbab(?:y|ies)|infant|newborn|toddler|\bgym|workout|exercis|fitness|cardio|\bweights?\b|\blift(?:ing)?\b|dumbbell|barbell"
                        r"|\bkeys?\b|keyring|keychain|keyhole|\blocks?\b|\bunlock|locksmith|measur|\bgauges?\b|calibrat",
+    },
+    "gift-dev5": {
+        "siblings": [("mirrored_things", "chocolate"), ("seashells", "cordage"),
+                     ("footwear", "magic_props"), ("cutlery", "adhesives")],
+        "label_words": r"mirror|reflect|looking.glass|chocolat|cacao|shell|mollus|\bclams?\b|oyster|nacre|mother.of.pearl"
+                       r"|\bstrings?\b|\bcords?\b|cordage|\bropes?\b|twine"
+                       r"|footwear|\bshoes?\b|\bboots?\b|slipper|sandal|sneaker|\btrainers?\b"
+                       r"|magic|magician|conjur|illusion|\btricks?\b|\bprops?\b"
+                       r"|cutlery|silverware|flatware|utensil|\bforks?\b|\bspoons?\b|\bknife|\bknives"
+                       r"|adhesi|\bglues?\b|\bgluing\b|\bsticky\b|\bsticking\b|\btapes?\b|\bpastes?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
