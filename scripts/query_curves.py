@@ -106,7 +106,7 @@ def merge(results: list[dict]) -> dict:
     the first one's provenance, with every one's command, commit and code version kept under ``parts``.
     Runs of different recipes (kernel, re-scoring, LM model file) are refused."""
     first = results[0]
-    keys = ("kernel", "rescore", "random_seeds")
+    keys = ("kernel", "rescore", "random_seeds", "move")
     for r in results[1:]:
         for k in keys:
             if r.get(k) != first.get(k):
@@ -168,8 +168,10 @@ def write(result: dict, md: Path) -> None:
     lines = [title, "",
              "When the intent-conditioned kernel is unsure, gift can ask the human \"is this object part of the "
              "goal?\" about a few test objects and re-score the scene with the answers, or abstain on an object "
-             "(leave it out of the aligned reward). The rules (answered objects are fixed; answers join the "
-             "leave-one-out evidence of the train-calibrated cut; answers choose among intent candidates; "
+             "(leave it out of the aligned reward). The rules (answered objects are fixed; " + (
+                 "the cut stays where it was without answers; " if result.get("move") == "stay" else
+                 "answers join the leave-one-out evidence of the train-calibrated cut; ") +
+             "answers choose among intent candidates; "
              "abstained objects are dropped like distractors) are in `gift.core.queries` "
              "([API](../reference/alignment.md)); `gift align --ask N`, `gift evaluate-alignment --queries N` "
              "and `gift reproduce --queries N` use them ([command line](../cli.md)).", "",
@@ -233,7 +235,12 @@ def write(result: dict, md: Path) -> None:
               *(["- The rule by which answers move the cut was changed once, after the first `gift-paper` run: the "
                  "first rule (the widest-gap midpoint) let one or two hard negatives lift the cut past unasked "
                  "relevant objects (its numbers are in each suite's table below). The dev suites were first run "
-                 "with the adopted rule."] if any("widest" in r for r in result["runs"].values()) else []),
+                 "with the adopted rule."] if any("widest" in r for r in result["runs"].values())
+                and result.get("move", "nearest") == "nearest" else []),
+              *([f"- Answers move the cut by `move=\"{result['move']}\"`"
+                 + (" (the default: answers never move the cut, they only fix the objects they are about)"
+                    if result["move"] == "stay" else "") + "; the first rule tried (the widest-gap midpoint) is "
+                 "in each suite's table below."] if result.get("move", "nearest") != "nearest" else []),
               "- Win rates depend on the simulator's scenes at the commit below: the k = 0 row is `gift reproduce "
               "--kernels gift-prob` at the same commit and sizes.", ""]
     for source in sources:
@@ -308,8 +315,10 @@ def write(result: dict, md: Path) -> None:
               "about the one `gift-prob`'s LM and MiniLM terms (or, when there are several, the intent "
               "candidates) disagree on most; *error-bound* about the one whose answer is expected to lower the "
               "paper's error bound of the scene's test trajectories most; *random* is the baseline.",
-              "- An answer fixes its object and moves the train-calibrated cut, so one answer can also flip "
-              "objects that were not asked about, in either direction.",
+              ("- An answer fixes its object and, here, leaves the cut where it was: only the objects asked about "
+               "change." if result.get("move") == "stay" else
+               "- An answer fixes its object and moves the train-calibrated cut, so one answer can also flip "
+               "objects that were not asked about, in either direction."),
               "- The issue's targets: with at most 2 questions per intent, inferred-intent F1 of at least 0.90 on "
               "`gift-paper`; the best policy needing at most half the questions random needs for the same F1 "
               "(a ratio of 0.5 or less in the tables above).", ""]
@@ -334,9 +343,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default="docs/results/queries.md")
     p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
     p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
-    from gift.core.queries import MOVES
+    from gift.core.queries import DEFAULT_MOVE, MOVES
 
-    p.add_argument("--move", default="nearest", choices=MOVES,
+    p.add_argument("--move", default=DEFAULT_MOVE, choices=MOVES,
                    help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
     p.add_argument("--rescore", action="store_true",
                    help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "

@@ -60,17 +60,20 @@ def test_the_prior_survives_json_and_views_and_old_records_read_without_it():
     assert AlignmentScores.from_dict(old).threshold("train-calibrated")[0] == pytest.approx(LOO)
 
 
-def test_answers_move_the_cut_from_the_averaged_one():
+def test_answers_move_the_cut_from_the_averaged_one_with_move_nearest_and_leave_it_by_default():
     s = scores(prior_cut=0.5)
     anchor = s.threshold("train-calibrated")[0]
     assert anchor == pytest.approx(0.5 * 0.5 + 0.5 * LOO) == pytest.approx(0.525)
     assert answered_cut(s, "train-calibrated", ())[0] == pytest.approx(anchor)
     # a "yes" the averaged cut already gets right (x, 0.7) moves nothing
-    assert answered_cut(s, "train-calibrated", [Answer("x", True)])[0] == pytest.approx(anchor)
+    assert answered_cut(s, "train-calibrated", [Answer("x", True)], move="nearest")[0] == pytest.approx(anchor)
     # a "yes" below it (z, 0.45) lowers the cut just past z; a "no" above it (y, 0.55) lifts it just past y
-    cut, note = answered_cut(s, "train-calibrated", [Answer("z", True)])
+    cut, note = answered_cut(s, "train-calibrated", [Answer("z", True)], move="nearest")
     assert cut == pytest.approx(0.375) and "1 yes / 0 no answers" in note
-    assert answered_cut(s, "train-calibrated", [Answer("y", False)])[0] == pytest.approx(0.625)
+    assert answered_cut(s, "train-calibrated", [Answer("y", False)], move="nearest")[0] == pytest.approx(0.625)
+    # the default (move="stay"): the averaged cut, whatever the answers say
+    for answers in ([Answer("z", True)], [Answer("y", False)], [Answer("z", True), Answer("y", False)]):
+        assert answered_cut(s, "train-calibrated", answers)[0] == pytest.approx(anchor)
 
 
 @pytest.mark.parametrize("bad", [{"prior_cut": 1.5}, {"prior_cut": -0.1}, {"prior_weight": 2.0},

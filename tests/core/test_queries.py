@@ -14,6 +14,7 @@ from gift.core.data import DISTRACTOR, FeatureBatch, FeatureSpec, ObjectSpec, Re
 from gift.core.errors import GiftError
 from gift.core.interfaces import QueryPolicy, RelevanceKernel, SimilarityKernel
 from gift.core.queries import (
+    DEFAULT_MOVE,
     Answer,
     QueryProblem,
     answered_cut,
@@ -69,7 +70,7 @@ def scores_of(test_r=None, train_r=None, relevant=("a", "b"), details=None, gues
 
 def test_answers_are_fixed_and_join_the_leave_one_out_evidence_of_the_train_calibrated_cut():
     s = scores_of()
-    p = QueryProblem.of(s)
+    p = QueryProblem.of(s, move="nearest")
     st0 = resolve(p)
     assert st0.cut == pytest.approx(0.5) and st0.predicted.tolist() == [True, True, False, False]
     # "no" about y (0.55): a negative next to the training negatives 0.2, 0.3 -> cut between 0.55 and 0.7
@@ -99,13 +100,14 @@ def test_the_cut_moves_only_as_far_as_the_answers_require():
     s = scores_of(test_r={"x": 0.7, "y": 0.6, "z": 0.65, "w": 0.1}, train_r={"a": 0.8, "b": 0.78, "c": 0.3, "d": 0.2})
     assert s.threshold("train-calibrated")[0] == pytest.approx(0.54)  # the widest gap: (0.3 + 0.78) / 2
     no = [Answer("y", False)]
-    nearest = resolve(QueryProblem.of(s), no)
+    nearest = resolve(QueryProblem.of(s, move="nearest"), no)
     assert nearest.cut == pytest.approx(0.625)  # just past y, below z (0.65)
     assert nearest.predicted.tolist() == [True, False, True, False]
     widest = resolve(QueryProblem.of(s, move="widest"), no)
     assert widest.cut == pytest.approx(0.69) and widest.predicted.tolist() == [True, False, False, False]
     # an answer the cut already gets right moves nothing
-    assert resolve(QueryProblem.of(s), [Answer("w", False), Answer("x", True)]).cut == pytest.approx(0.54)
+    assert resolve(QueryProblem.of(s, move="nearest"), [Answer("w", False), Answer("x", True)]).cut == \
+        pytest.approx(0.54)
     assert resolve(QueryProblem.of(s, move="widest"), [Answer("x", True)]).cut == pytest.approx(0.5)
     with pytest.raises(GiftError, match="unknown cut move 'far'"):
         QueryProblem.of(s, move="far")
@@ -122,7 +124,7 @@ def test_move_answers_keeps_the_cut_without_answers_and_moves_it_only_for_answer
     # weighs again, would keep it at 0.54)
     low_yes = resolve(problem, [Answer("w", True)])
     assert low_yes.cut == pytest.approx(0.1, abs=1e-5) and low_yes.predicted.tolist() == [True, True, True, True]
-    assert resolve(QueryProblem.of(s), [Answer("w", True)]).cut == pytest.approx(0.54)
+    assert resolve(QueryProblem.of(s, move="nearest"), [Answer("w", True)]).cut == pytest.approx(0.54)
     assert "moved only as far as 1 yes / 0 no answers require" in low_yes.note
 
 
@@ -135,7 +137,10 @@ def test_move_stay_keeps_the_cut_without_answers_and_only_fixes_the_answered_obj
     assert st.predicted.tolist() == [True, False, True, True]  # y and w fixed, x and z as without answers
     assert st.alignment.target("y") == DISTRACTOR and st.alignment.scores["w"] == 1.0
     # with the same answers, "nearest" lifts the cut just past the "no" at 0.6
-    assert resolve(QueryProblem.of(s), [Answer("y", False)]).cut > 0.6 > cut0
+    assert resolve(QueryProblem.of(s, move="nearest"), [Answer("y", False)]).cut > 0.6 > cut0
+    # it is the default
+    assert QueryProblem.of(s).move == DEFAULT_MOVE == "stay"
+    assert resolve(QueryProblem.of(s), [Answer("y", False), Answer("w", True)]).to_dict() == st.to_dict()
 
 
 def test_answers_do_not_move_fixed_or_non_oracle_cuts_but_still_fix_the_answered_objects():
@@ -152,9 +157,9 @@ def test_answers_alone_place_the_cut_when_no_relevant_training_object_is_known()
     assert s.loo_scores is None and s.relevant_mask.tolist() == [True, True, False, False]
     base, note = s.threshold("train-calibrated")
     assert "fallback" in note
-    one = answered_cut(s, "train-calibrated", [Answer("x", True)])
+    one = answered_cut(s, "train-calibrated", [Answer("x", True)], move="nearest")
     assert one[0] == base and "no second class yet" in one[1]
-    cut, note = answered_cut(s, "train-calibrated", [Answer("x", True), Answer("y", False)])
+    cut, note = answered_cut(s, "train-calibrated", [Answer("x", True), Answer("y", False)], move="nearest")
     assert cut == pytest.approx((0.9 + 0.55) / 2) and "0 relevant / 0 other" in note
 
 
@@ -188,7 +193,7 @@ def test_a_yes_on_a_matrix_kernel_goes_to_the_best_relevant_training_object():
 
 def test_abstention_flags_objects_in_the_band_and_drops_their_features_like_a_distractor():
     s = scores_of()
-    st = resolve(QueryProblem.of(s, abstain=0.06))
+    st = resolve(QueryProblem.of(s, abstain=0.06, move="nearest"))
     assert st.cut == pytest.approx(0.5) and st.abstained == ("y", "z")  # |0.55 - 0.5|, |0.45 - 0.5| < 0.06
     assert st.alignment.target("y") == DISTRACTOR and not st.predicted[1] and st.decision[1] == -1.0
     assert st.alignment.target("x") == "a"

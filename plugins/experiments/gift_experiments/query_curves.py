@@ -24,7 +24,7 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
+from gift.core.queries import DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
 
 log = logging.getLogger("gift.query_curves")
 
@@ -100,7 +100,7 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
 
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
-            grid: Sequence[int] = K_GRID, move: str = "nearest", rescore: bool = False) -> list[QueryState]:
+            grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = False) -> list[QueryState]:
     """The states after k questions for each k of ``grid`` (the last state when every object was asked);
     ``rescore``: the kernel scores the scene again with the answers (rule 5; LM calls), when it can."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
@@ -136,7 +136,7 @@ def _aggregate(per_intent: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
             "abstained": int(sum(o["abstained"] for o in per_intent.values()))}
 
 
-def best_questions(data: IntentData, k: int = 2, move: str = "nearest") -> tuple[QueryState, dict[str, Any]]:
+def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE) -> tuple[QueryState, dict[str, Any]]:
     """The ceiling of any policy: the ``k`` questions, chosen with the labels among all sets of ``k`` test
     objects, after whose answers (rules 1-3 of :mod:`gift.core.queries`, no re-scoring) the scene has the fewest
     wrong decisions (fp + fn; ties: more tp, then the first set in scene order). Per intent no policy gets fewer
@@ -155,7 +155,7 @@ def best_questions(data: IntentData, k: int = 2, move: str = "nearest") -> tuple
 
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
-             bands: Sequence[float] = BANDS, move: str = "nearest", rescore: bool = False,
+             bands: Sequence[float] = BANDS, move: str = DEFAULT_MOVE, rescore: bool = False,
              policies: Sequence[str] = POLICIES) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
