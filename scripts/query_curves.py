@@ -79,13 +79,14 @@ def run(args: argparse.Namespace) -> dict:
             if not data:
                 continue
             sim = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid, policies=args.policies,
-                              rescore=args.rescore, move=args.move)
+                              rescore=args.rescore, move=args.move, choose=args.choose)
             if args.rescore:  # the same sessions with answers that only re-threshold, for the comparison
                 sim["without_rescore"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
-                                                     policies=args.policies, bands=())["curves"]
+                                                     policies=args.policies, bands=(), choose=args.choose)["curves"]
             else:  # the first cut rule tried (widest gap), for the record
                 sim["widest"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
-                                            policies=args.policies, bands=(), move="widest")["curves"]
+                                            policies=args.policies, bands=(), move="widest",
+                                            choose=args.choose)["curves"]
             sim.update({"suite": suite.name, "intent_source": source, "robot": args.robot, "kernel": args.kernel,
                         "config": attrs.asdict(cfg), "target": qc.target_check(sim),
                         "intents": {d.intent: {"intent_text": d.intent_text, "relevant": list(d.relevant),
@@ -97,6 +98,7 @@ def run(args: argparse.Namespace) -> dict:
     out["random_seeds"] = args.random_seeds
     out["rescore"] = bool(args.rescore)
     out["move"] = args.move
+    out["choose"] = args.choose
     out["seconds"] = round(time.perf_counter() - t_all, 1)
     return out
 
@@ -106,7 +108,7 @@ def merge(results: list[dict]) -> dict:
     the first one's provenance, with every one's command, commit and code version kept under ``parts``.
     Runs of different recipes (kernel, re-scoring, LM model file) are refused."""
     first = results[0]
-    keys = ("kernel", "rescore", "random_seeds", "move")
+    keys = ("kernel", "rescore", "random_seeds", "move", "choose")
     for r in results[1:]:
         for k in keys:
             if r.get(k) != first.get(k):
@@ -237,6 +239,8 @@ def write(result: dict, md: Path) -> None:
                  "relevant objects (its numbers are in each suite's table below). The dev suites were first run "
                  "with the adopted rule."] if any("widest" in r for r in result["runs"].values())
                 and result.get("move", "nearest") == "nearest" else []),
+              *([f"- The kernel's own intent candidate decides whatever the answers say (`choose=\"primary\"`, "
+                 "rule 3 of `gift.core.queries`)."] if result.get("choose") == "primary" else []),
               *([f"- Answers move the cut by `move=\"{result['move']}\"`"
                  + (" (the default: answers never move the cut, they only fix the objects they are about)"
                     if result["move"] == "stay" else "") + "; the first rule tried (the widest-gap midpoint) is "
@@ -343,10 +347,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default="docs/results/queries.md")
     p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
     p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
-    from gift.core.queries import DEFAULT_MOVE, MOVES
+    from gift.core.queries import CHOOSE, DEFAULT_CHOOSE, DEFAULT_MOVE, MOVES
 
     p.add_argument("--move", default=DEFAULT_MOVE, choices=MOVES,
                    help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
+    p.add_argument("--choose", default=DEFAULT_CHOOSE, choices=CHOOSE,
+                   help="which intent candidate decides after answers (rule 3 of gift.core.queries)")
     p.add_argument("--rescore", action="store_true",
                    help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "
                         "the curves without it are kept next to them")

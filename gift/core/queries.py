@@ -47,7 +47,9 @@ How answers update the scene (the rule)
 3. **Answers choose among intent candidates.** With several candidates, each one is charged the number
    of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
    fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
-   The chosen candidate's scores, re-thresholded by rule 2, decide the objects not answered.
+   The chosen candidate's scores, re-thresholded by rule 2, decide the objects not answered. With
+   ``choose="primary"`` the kernel's own candidate always decides (the others stay views the policies read):
+   one or two answers are little evidence against the kernel's own training-side choice.
 4. **Abstention.** An object not answered (or answered "don't know") whose decision score lies strictly
    within ``abstain`` of the cut, ``|decision - cut| < abstain``, is *flagged* instead of decided: it is
    reported, and its semantic features are held out of scoring exactly as a distractor's are (its
@@ -111,6 +113,10 @@ PRIMARY = "primary"
 MOVES = ("stay", "nearest", "widest", "answers")
 #: The default of :data:`MOVES` (docs/results/queries.md, "Answers that leave the cut where it was").
 DEFAULT_MOVE = "stay"
+#: Which intent candidate decides after answers (rule 3): ``answers`` (the one whose decisions the answers
+#: contradict least) or ``primary`` (always the kernel's own; the others stay views for the policies).
+CHOOSE = ("answers", "primary")
+DEFAULT_CHOOSE = "answers"
 
 
 # ============================================================================= answers
@@ -231,6 +237,11 @@ def _check_move(inst: Any, attribute: attrs.Attribute, value: str) -> None:
         raise GiftError(f"unknown cut move {value!r}; one of {MOVES}")
 
 
+def _check_choose(inst: Any, attribute: attrs.Attribute, value: str) -> None:
+    if value not in CHOOSE:
+        raise GiftError(f"unknown candidate choice {value!r}; one of {CHOOSE}")
+
+
 def _check_band(inst: Any, attribute: attrs.Attribute, value: float) -> None:
     if not 0.0 <= float(value) <= 1.0:
         raise GiftError(f"the abstention band must be in [0, 1] (distance to the cut on the decision scale), "
@@ -304,7 +315,8 @@ class QueryProblem:
     abstention band on the decision scale (0: never abstain); ``test_labels``: only for the oracle cut;
     ``move``: how answers move the train-calibrated cut (:data:`MOVES`, rule 2); ``rescore``: ``answers
     (object -> bool) -> AlignmentScores | None``, the scene scored again with the answers (rule 5;
-    :func:`kernel_rescorer`), None: answers only re-threshold.
+    :func:`kernel_rescorer`), None: answers only re-threshold; ``choose``: which candidate decides after
+    answers (:data:`CHOOSE`, rule 3).
     """
 
     candidates: Mapping[str, AlignmentScores] = attrs.field(converter=dict)
@@ -315,6 +327,7 @@ class QueryProblem:
     test_labels: Mapping[str, bool] | None = None
     move: str = attrs.field(default=DEFAULT_MOVE, validator=_check_move)
     rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = attrs.field(default=None, eq=False)
+    choose: str = attrs.field(default=DEFAULT_CHOOSE, validator=_check_choose, kw_only=True)
     _rescored: dict = attrs.field(factory=dict, init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
@@ -337,8 +350,8 @@ class QueryProblem:
     def of(cls, scores: AlignmentScores, strategy: str | float = "train-calibrated", *,
            candidates: Mapping[str, AlignmentScores] | None = None, trajectories: Sequence[FeatureBatch] = (),
            lipschitz: float = 1.0, abstain: float = 0.0, test_labels: Mapping[str, bool] | None = None,
-           move: str = DEFAULT_MOVE, rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = None
-           ) -> "QueryProblem":
+           move: str = DEFAULT_MOVE, rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = None,
+           choose: str = DEFAULT_CHOOSE) -> "QueryProblem":
         """The problem of one scene: ``scores`` (the kernel's own intent, named :data:`PRIMARY`), then
         ``candidates`` (other intents' scores of the same scene), then the candidates the kernel reported
         in ``scores.details["candidates"]``."""
@@ -347,7 +360,7 @@ class QueryProblem:
             if name in cands:
                 raise GiftError(f"two intent candidates are named {name!r}")
             cands[name] = s
-        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move, rescore)
+        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move, rescore, choose=choose)
 
     def candidates_for(self, answers: Sequence[Answer]) -> Mapping[str, AlignmentScores]:
         """The candidates that decide a scene with ``answers`` (rule 5): :attr:`candidates`, or, when the
@@ -584,13 +597,14 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = (), *,
         seen.add(a.object)
     known = [a for a in answers if a.relevant is not None]
     cands = problem.candidates_for(answers) if candidates is None else candidates  # rule 5
-    # rule 3: the candidate whose own decisions got the fewest answered objects wrong (ties: the earlier)
+    # rule 3: the candidate whose own decisions got the fewest answered objects wrong (ties: the earlier),
+    # or the kernel's own with choose="primary"
     mistakes = {}
     for name, s in cands.items():
         cut0, _ = answered_cut(s, problem.strategy, (), problem.test_labels)
         mistakes[name] = sum(bool(s.decision[test.index(a.object)] >= cut0) != a.relevant for a in known)
     order = list(cands)
-    chosen = min(order, key=lambda n: (mistakes[n], order.index(n)))
+    chosen = min(order, key=lambda n: (mistakes[n], order.index(n))) if problem.choose == "answers" else order[0]
     scores = cands[chosen]
     # rule 2: the cut after the answers (the problem's move; by default the cut without answers)
     cut, note = answered_cut(scores, problem.strategy, answers, problem.test_labels, problem.move)

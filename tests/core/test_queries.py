@@ -242,6 +242,18 @@ def test_answers_choose_among_intent_candidates():
         QueryProblem.of(primary, candidates={"bad": scores_of(test_r={"x": 0.1, "q": 0.2, "z": 0.3, "w": 0.4})})
 
 
+def test_choose_primary_keeps_the_kernels_own_candidate_whatever_the_answers_say():
+    primary = scores_of()  # predicts x, y
+    other = primary.with_relevance([0.2, 0.9, 0.1, 0.95], [0.8, 0.7, 0.3, 0.2])  # predicts y, w
+    p = QueryProblem.of(primary, candidates={"other": other}, choose="primary")
+    st = resolve(p, [Answer("w", True)])  # the answer contradicts the primary, not the other
+    assert st.chosen == "primary" and st.mistakes == {"primary": 1, "other": 0}  # still charged, for reports
+    assert st.predicted.tolist() == [True, True, False, True]  # primary's decisions, w fixed by its answer
+    assert "other" in st.view_beliefs()  # the other candidate stays a view for the policies
+    with pytest.raises(GiftError, match="unknown candidate choice 'best'"):
+        QueryProblem.of(primary, choose="best")
+
+
 def test_uncertainty_asks_nearest_the_cut_and_re_ranks_after_each_answer():
     s = scores_of()
     states = list(asking(QueryProblem.of(s), "uncertainty", labels_answerer(LABELS), 4))

@@ -24,7 +24,7 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
+from gift.core.queries import DEFAULT_CHOOSE, DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
 
 log = logging.getLogger("gift.query_curves")
 
@@ -100,12 +100,13 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
 
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
-            grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = False) -> list[QueryState]:
+            grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = False,
+            choose: str = DEFAULT_CHOOSE) -> list[QueryState]:
     """The states after k questions for each k of ``grid`` (the last state when every object was asked);
     ``rescore``: the kernel scores the scene again with the answers (rule 5; LM calls), when it can."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
     problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move,
-                              rescore=data.rescore if rescore else None)
+                              rescore=data.rescore if rescore else None, choose=choose)
     states = list(asking(problem, policy, labels_answerer(data.labels), max(grid), seed=seed))
     return [states[min(k, len(states) - 1)] for k in grid]
 
@@ -136,13 +137,14 @@ def _aggregate(per_intent: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
             "abstained": int(sum(o["abstained"] for o in per_intent.values()))}
 
 
-def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE) -> tuple[QueryState, dict[str, Any]]:
+def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE,
+                   choose: str = DEFAULT_CHOOSE) -> tuple[QueryState, dict[str, Any]]:
     """The ceiling of any policy: the ``k`` questions, chosen with the labels among all sets of ``k`` test
     objects, after whose answers (rules 1-3 of :mod:`gift.core.queries`, no re-scoring) the scene has the fewest
     wrong decisions (fp + fn; ties: more tp, then the first set in scene order). Per intent no policy gets fewer
     wrong decisions with ``k`` questions; pooled F1 is not separable over intents, so it is the ceiling of F1 up to
     that. Returns the state and its :func:`outcome`."""
-    problem = QueryProblem.of(data.scores, THRESHOLD, move=move)
+    problem = QueryProblem.of(data.scores, THRESHOLD, move=move, choose=choose)
     y = np.array([data.labels[t] for t in problem.test])
     best, best_value = None, None
     for chosen in itertools.combinations(problem.test, min(k, len(problem.test))):
@@ -156,10 +158,11 @@ def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE) -> tu
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
              bands: Sequence[float] = BANDS, move: str = DEFAULT_MOVE, rescore: bool = False,
-             policies: Sequence[str] = POLICIES) -> dict[str, Any]:
+             policies: Sequence[str] = POLICIES, choose: str = DEFAULT_CHOOSE) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
-    the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run. Returns
+    the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run; ``choose``:
+    which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
     per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy), None with ``rescore`` or without 2 in the grid."""
     curves: dict[str, Any] = {}
@@ -170,7 +173,7 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
         by_intent: dict[str, list] = {d.intent: [] for d in data}
         for seed in seeds:
             outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid, move=move,
-                                                                     rescore=rescore)]
+                                                                     rescore=rescore, choose=choose)]
                         for d in data}
             runs.append([_aggregate({i: o[k] for i, o in outcomes.items()}) for k in range(len(grid))])
             for i, o in outcomes.items():
@@ -191,16 +194,17 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
                               for i, runs_i in by_intent.items()}
     for policy in policies:  # which objects each deterministic policy asked about, in order, per intent
         for d in data:
-            last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore)[0]
+            last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore, choose=choose)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     bound = None
     if 2 in grid and not rescore:  # what any policy could reach with 2 questions (answers only re-threshold)
-        found = {d.intent: best_questions(d, 2, move) for d in data}
+        found = {d.intent: best_questions(d, 2, move, choose) for d in data}
         bound = {"k": 2, **_aggregate({i: o for i, (_, o) in found.items()}),
                  "asked": {i: [a.object for a in st.answers] for i, (st, _) in found.items()}}
     abstention = {}
     for band in bands:
-        outs = {d.intent: outcome(d, session(d, policies[0], 0, band, grid=(0,), move=move)[0]) for d in data}
+        outs = {d.intent: outcome(d, session(d, policies[0], 0, band, grid=(0,), move=move, choose=choose)[0])
+                for d in data}
         abstention[str(band)] = _aggregate(outs)
     return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention,
             "bound": bound}
