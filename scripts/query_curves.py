@@ -173,7 +173,8 @@ def write(result: dict, md: Path) -> None:
              "(leave it out of the aligned reward). The rules (answered objects are fixed; " + (
                  "the cut stays where it was without answers; " if result.get("move") == "stay" else
                  "answers join the leave-one-out evidence of the train-calibrated cut; ") +
-             "answers choose among intent candidates; "
+             ("the kernel's own intent candidate decides; " if result.get("choose") == "primary" else
+              "answers choose among intent candidates; ") +
              "abstained objects are dropped like distractors) are in `gift.core.queries` "
              "([API](../reference/alignment.md)); `gift align --ask N`, `gift evaluate-alignment --queries N` "
              "and `gift reproduce --queries N` use them ([command line](../cli.md)).", "",

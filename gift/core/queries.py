@@ -44,12 +44,13 @@ How answers update the scene (the rule)
    ``gift-paper``'s reading_material, two "no" answers turned five relevant books into distractors).
    ``"answers"``: the cut without answers moved only as far as the answers alone require. A ``fixed``,
    ``non-oracle`` or ``oracle`` cut is never moved by answers (only the answered objects change).
-3. **Answers choose among intent candidates.** With several candidates, each one is charged the number
-   of answered objects its own decisions (at its cut without answers) got wrong; the candidate with the
-   fewest mistakes is chosen, ties going to the earlier one (the first is the kernel's own choice).
-   The chosen candidate's scores, re-thresholded by rule 2, decide the objects not answered. With
-   ``choose="primary"`` the kernel's own candidate always decides (the others stay views the policies read):
-   one or two answers are little evidence against the kernel's own training-side choice.
+3. **The kernel's own intent candidate decides** (``choose="primary"``, the default since 2026-12-03,
+   docs/results/queries.md). Other candidates stay views the policies read (``disagreement``). With
+   ``choose="answers"`` (the default before) answers choose among the candidates: each one is charged the
+   number of answered objects its own decisions (at its cut without answers) got wrong, and the one with the
+   fewest mistakes decides, ties going to the earlier one (the first is the kernel's own). One or two answers
+   are little evidence against the kernel's own, training-side choice: on ``gift-paper`` one "no" handed
+   ``reading_material`` to a candidate with 12 objects wrong instead of 4.
 4. **Abstention.** An object not answered (or answered "don't know") whose decision score lies strictly
    within ``abstain`` of the cut, ``|decision - cut| < abstain``, is *flagged* instead of decided: it is
    reported, and its semantic features are held out of scoring exactly as a distractor's are (its
@@ -113,10 +114,11 @@ PRIMARY = "primary"
 MOVES = ("stay", "nearest", "widest", "answers")
 #: The default of :data:`MOVES` (docs/results/queries.md, "Answers that leave the cut where it was").
 DEFAULT_MOVE = "stay"
-#: Which intent candidate decides after answers (rule 3): ``answers`` (the one whose decisions the answers
-#: contradict least) or ``primary`` (always the kernel's own; the others stay views for the policies).
-CHOOSE = ("answers", "primary")
-DEFAULT_CHOOSE = "answers"
+#: Which intent candidate decides after answers (rule 3): ``primary`` (the default: always the kernel's own; the
+#: others stay views for the policies) or ``answers`` (the default before: the one the answers contradict least).
+CHOOSE = ("primary", "answers")
+#: The default of :data:`CHOOSE` (docs/results/queries.md, "The kernel's own candidate decides").
+DEFAULT_CHOOSE = "primary"
 
 
 # ============================================================================= answers
@@ -597,8 +599,8 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = (), *,
         seen.add(a.object)
     known = [a for a in answers if a.relevant is not None]
     cands = problem.candidates_for(answers) if candidates is None else candidates  # rule 5
-    # rule 3: the candidate whose own decisions got the fewest answered objects wrong (ties: the earlier),
-    # or the kernel's own with choose="primary"
+    # rule 3: the kernel's own candidate (choose="primary"), or the one whose own decisions got the fewest
+    # answered objects wrong (choose="answers"; ties: the earlier); mistakes are counted for reports either way
     mistakes = {}
     for name, s in cands.items():
         cut0, _ = answered_cut(s, problem.strategy, (), problem.test_labels)

@@ -14,6 +14,7 @@ from gift.core.data import DISTRACTOR, FeatureBatch, FeatureSpec, ObjectSpec, Re
 from gift.core.errors import GiftError
 from gift.core.interfaces import QueryPolicy, RelevanceKernel, SimilarityKernel
 from gift.core.queries import (
+    DEFAULT_CHOOSE,
     DEFAULT_MOVE,
     Answer,
     QueryProblem,
@@ -216,7 +217,7 @@ def test_abstention_flags_objects_in_the_band_and_drops_their_features_like_a_di
 def test_answers_choose_among_intent_candidates():
     primary = scores_of()  # predicts x, y
     other = primary.with_relevance([0.2, 0.9, 0.1, 0.95], [0.8, 0.7, 0.3, 0.2])  # predicts y, w
-    p = QueryProblem.of(primary, candidates={"other": other})
+    p = QueryProblem.of(primary, candidates={"other": other}, choose="answers")
     assert resolve(p).chosen == "primary"
     st = resolve(p, [Answer("w", True)])  # primary had w wrong, the other right
     assert st.chosen == "other" and st.mistakes == {"primary": 1, "other": 0}
@@ -233,7 +234,7 @@ def test_answers_choose_among_intent_candidates():
               {"goal": "store metal items", "chosen": False, "lm_test": [-2.0, 3.0, -3.0, 4.0],
                "lm_train": [2.0, 1.5, -1.0, -2.0]},
               {"goal": "tidy up", "chosen": False}]
-    p = QueryProblem.of(scores_of(details={"candidates": listed}))
+    p = QueryProblem.of(scores_of(details={"candidates": listed}), choose="answers")
     assert list(p.candidates) == ["primary", "store metal items"]
     assert resolve(p, [Answer("w", True)]).chosen == "store metal items"
     with pytest.raises(GiftError, match="3 test / 4 training scores for 4 / 4"):
@@ -245,7 +246,8 @@ def test_answers_choose_among_intent_candidates():
 def test_choose_primary_keeps_the_kernels_own_candidate_whatever_the_answers_say():
     primary = scores_of()  # predicts x, y
     other = primary.with_relevance([0.2, 0.9, 0.1, 0.95], [0.8, 0.7, 0.3, 0.2])  # predicts y, w
-    p = QueryProblem.of(primary, candidates={"other": other}, choose="primary")
+    p = QueryProblem.of(primary, candidates={"other": other})  # the default
+    assert p.choose == DEFAULT_CHOOSE == "primary"
     st = resolve(p, [Answer("w", True)])  # the answer contradicts the primary, not the other
     assert st.chosen == "primary" and st.mistakes == {"primary": 1, "other": 0}  # still charged, for reports
     assert st.predicted.tolist() == [True, True, False, True]  # primary's decisions, w fixed by its answer
