@@ -563,8 +563,10 @@ class QueryState:
         return float(self.error_bounds().sum())
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-able: the answers, the cut and its note, the chosen candidate, flagged objects, f_ω."""
-        return {"chosen": self.chosen, "candidates": list(self.candidates or self.problem.candidates),
+        """JSON-able: the answers, the cut and its note, the chosen candidate, flagged objects, f_ω, and the
+        rules that made them (``move``, ``choose``)."""
+        return {"move": self.problem.move, "choose": self.problem.choose,
+                "chosen": self.chosen, "candidates": list(self.candidates or self.problem.candidates),
                 "mistakes": dict(self.mistakes), "rescored": self.rescored,
                 "cut": self.cut, "note": self.note, "answers": [a.to_dict() for a in self.answers],
                 "asked": len(self.answers), "abstained": list(self.abstained), "n_abstained": len(self.abstained),

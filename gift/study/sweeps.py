@@ -33,6 +33,7 @@ from gift.core.errors import GiftError
 from gift.core.executor import ExecutionError, Executor, using_executor
 from gift.core.metrics import pooled_alignment_metrics
 from gift.core.provenance import code_version, file_sha256, git_commit
+from gift.core.queries import DEFAULT_CHOOSE, DEFAULT_MOVE
 from gift.core.suite import Suite, load_suite
 from gift.study.chain import (
     INTENT_SOURCES,
@@ -512,7 +513,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                            "thresholds": list(thresholds), "lm": lm, "kernels": {}}
     if queries or abstain:
         out["queries"] = {"n": queries, "policy": query_policy, "abstain": abstain, "rescore": query_rescore,
-                          "threshold": query_threshold(cfg)}
+                          "threshold": query_threshold(cfg), "move": DEFAULT_MOVE, "choose": DEFAULT_CHOOSE}
     out_dir = None if stages is None else str(Path(stages).resolve())
     with using_executor(executor) as ex:
         table = _Table(out, suite, thresholds, progress, checkpoint, live=ex.in_process)

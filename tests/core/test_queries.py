@@ -200,6 +200,7 @@ def test_abstention_flags_objects_in_the_band_and_drops_their_features_like_a_di
     assert st.alignment.target("x") == "a"
     d = st.to_dict()
     assert d["n_abstained"] == 2 and d["abstained"] == ["y", "z"]
+    assert d["move"] == "nearest" and d["choose"] == "primary"  # the rules that made it
     # its semantic columns are dropped by f_ω, exactly as a distractor's; it adds nothing to the bound
     specs = [FeatureSpec(f"{o}_near", subject=o) for o in ("x", "y")]
     tspecs = [FeatureSpec(f"{o}_near", subject=o) for o in TRAIN]

@@ -92,7 +92,7 @@ def test_evaluate_alignment_with_queries_answered_from_the_suite_labels(tmp_path
     assert "| language | train-calibrated +2q uncertainty abstain 0.01 (" in table
     res = json.loads(out.read_text())
     assert res["queries"] == {"n": 2, "policy": "uncertainty", "abstain": 0.01, "threshold": "train-calibrated",
-                              "rescore": False}
+                              "rescore": False, "move": "stay", "choose": "primary"}
     suite = load_suite(SUITE)
     k = res["kernels"]["language"]
     for spec in suite.intents:
