@@ -92,14 +92,19 @@ def test_cli_align_refuses_objects_outside_any_catalog_unless_allowed(capsys, tm
                  "--kernel", "language"]) == 1
     assert "--relevant ['sketchbook']: not among the --train objects" in capsys.readouterr().err
 
-    code = main(["align", "--train", "paintbrush", "sketchbook", "banana", "--test", "toothbrush", "tuning fork",
+    # an object no registered suite holds (suites grow: this precondition names the clash instead of the
+    # warning silently disappearing, as "glue stick" and "tuning fork" did)
+    from gift_kernels.cli import lookup_objects
+
+    assert lookup_objects(["theremin"], None)[1] == ["theremin"], "pick another made-up object: a suite now has it"
+    code = main(["align", "--train", "paintbrush", "sketchbook", "banana", "--test", "toothbrush", "theremin",
                  "--relevant", "paintbrush", "sketchbook", "--kernel", "language", "--threshold", "0.5", "--json",
                  "--allow-unknown"])
     assert code == 0
     captured = capsys.readouterr()
-    assert "warning: 1 object(s) in no catalog" in captured.err and "tuning fork" in captured.err
+    assert "warning: 1 object(s) in no catalog" in captured.err and "theremin" in captured.err
     out = json.loads(captured.out)
-    assert out["unknown_objects"]["names"] == ["tuning fork"]
+    assert out["unknown_objects"]["names"] == ["theremin"]
     rows = {r["object"]: r for r in out["alignment"]}
     assert rows["toothbrush"]["target"] == "paintbrush" and rows["toothbrush"]["relevant"] is True
     assert out["threshold"] == 0.5 and np.array(out["similarity"]["K"]).shape == (2, 3)
