@@ -24,7 +24,8 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import DEFAULT_CHOOSE, DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking, labels_answerer, resolve
+from gift.core.queries import (DEFAULT_CHOOSE, DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking,
+                               labels_answerer, resolve)
 
 log = logging.getLogger("gift.query_curves")
 
@@ -164,7 +165,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
     the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run; ``choose``:
     which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
-    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy), None with ``rescore`` or without 2 in the grid."""
+    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy), None with ``rescore``
+    or without 2 in the grid."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
     for policy in tuple(policies) + (BASELINE,):
