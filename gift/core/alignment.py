@@ -222,6 +222,30 @@ def oracle_cut(scores: Sequence[float], labels: Sequence[bool]) -> float:
     return float(cands[best])
 
 
+def middle_f1_cut(scores: np.ndarray, labels: np.ndarray) -> float:
+    """The F1-best cut on these labels placed between scores: candidates are midpoints of neighbouring scores in
+    [0, 1] and points just outside them; of equally good candidates the middle one (the median)."""
+    v = np.unique(scores[scores >= 0.0])
+    if v.size == 0:
+        return 1.0 + 1e-9
+    cands = np.concatenate([[v[0] - 1e-6], (v[:-1] + v[1:]) / 2, [v[-1] + 1e-6]])
+    f1 = np.array([binary_metrics(scores >= c, labels).f1 for c in cands])
+    tied = cands[np.isclose(f1, f1.max())]
+    return float(tied[(tied.size - 1) // 2])
+
+
+def leave_one_out_oracle(scores: Sequence[float], labels: Sequence[bool]) -> np.ndarray:
+    """``[n]`` bool: object i is predicted relevant iff its score reaches the F1-best cut of the other ``n - 1``
+    objects and their labels (placed between their scores; of equal cuts the middle one). What a cut chosen with
+    labels does out of sample, against the in-sample maximum of :func:`oracle_cut`."""
+    s = np.asarray(scores, dtype=float)
+    y = np.asarray(labels, dtype=bool)
+    if s.shape != y.shape or s.ndim != 1:
+        raise GiftError(f"leave_one_out_oracle needs one label per score, got shapes {s.shape} and {y.shape}")
+    keep = ~np.eye(s.size, dtype=bool)
+    return np.array([s[i] >= middle_f1_cut(s[keep[i]], y[keep[i]]) for i in range(s.size)], dtype=bool)
+
+
 @attrs.frozen
 class AlignmentScores:
     """Everything the kernel said about one test scene, before a threshold is chosen.

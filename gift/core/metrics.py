@@ -109,19 +109,6 @@ def roc_auc(scores: Sequence[float], labels: Sequence[bool]) -> float:
     return float(((diff > 0).sum() + 0.5 * (diff == 0).sum()) / diff.size)
 
 
-def best_f1_threshold(scores: Sequence[float], labels: Sequence[bool]) -> float:
-    """The cut (``score >= cut`` is positive) that maximises F1 on these labels: the oracle threshold."""
-    s = np.asarray(scores, dtype=float)
-    y = np.asarray(labels, dtype=bool)
-    cands = np.unique(s)
-    best, best_f1 = float(cands[0]) if cands.size else 0.5, -1.0
-    for c in cands:
-        f1 = binary_metrics(s >= c, y).f1
-        if f1 > best_f1:
-            best, best_f1 = float(c), f1
-    return best
-
-
 def cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cosine similarity matrix of row vectors: ``[n, d] x [m, d] -> [n, m]``."""
     a = np.asarray(a, dtype=float)

@@ -26,7 +26,6 @@ def test_binary_metrics_auc_threshold_boltzmann_cosine():
     assert metrics.roc_auc([0.9, 0.8, 0.1], [1, 1, 0]) == 1.0
     assert metrics.roc_auc([0.5, 0.5], [1, 0]) == 0.5
     assert np.isnan(metrics.roc_auc([0.1], [1]))
-    assert metrics.best_f1_threshold([0.9, 0.6, 0.4, 0.1], [1, 1, 0, 0]) == 0.6
     p = metrics.boltzmann(np.array([[0.0, np.log(3.0)]]))
     assert np.allclose(p, [[0.25, 0.75]])
     assert metrics.mean_se([1.0, 3.0]) == (2.0, 1.0)

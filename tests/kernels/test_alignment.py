@@ -10,6 +10,7 @@ from gift.core.alignment import (
     NEVER,
     ArgmaxThresholdAlignment,
     best_separating_cut,
+    leave_one_out_oracle,
     matrix_decision,
     oracle_cut,
     score_alignment,
@@ -18,6 +19,7 @@ from gift.core.alignment import (
 from gift.core.data import DISTRACTOR, Alignment, FeatureBatch, ObjectSpec, RelevanceScores
 from gift.core.errors import GiftError
 from gift.core.interfaces import RelevanceKernel, SimilarityKernel
+from gift.core.metrics import binary_metrics
 from gift.tasks import PackBackpack
 
 TRAIN = [ObjectSpec(n) for n in ("paintbrush", "sketchbook", "banana", "coffee mug")]
@@ -82,6 +84,24 @@ def test_cuts():
     s = np.array([0.9, 0.8, 0.3, 0.2, NEVER])
     y = np.array([True, True, False, True, False])
     assert oracle_cut(s, y) == pytest.approx(0.2)  # F1 6/7: every object except the NEVER one
+
+
+def test_leave_one_out_oracle_decides_each_object_by_the_cut_of_the_others():
+    # separable: every object's cut from the others still separates, so the out-of-sample F1 is the oracle's
+    s = np.array([0.9, 0.8, 0.7, 0.3, 0.2, 0.1])
+    y = np.array([True, True, True, False, False, False])
+    assert leave_one_out_oracle(s, y).tolist() == y.tolist()
+    # in sample, the cut 0.4 takes every object (F1 6/8); left out, the lowest positive meets the cuts of the
+    # other four, where just below 0.5 and 0.85 both give F1 2/3; of two tied cuts the lower is the middle one
+    s = np.array([0.9, 0.8, 0.6, 0.5, 0.4])
+    y = np.array([True, False, False, True, True])
+    assert oracle_cut(s, y) == pytest.approx(0.4)
+    p = leave_one_out_oracle(s, y)
+    assert p.tolist() == [True, True, True, True, False]
+    assert binary_metrics(p, y).f1 < binary_metrics(s >= oracle_cut(s, y), y).f1
+    assert p.shape == (5,) and p.dtype == bool
+    with pytest.raises(GiftError):
+        leave_one_out_oracle([0.1, 0.2], [True])
 
 
 def test_three_thresholds_on_one_scoring_and_train_calibrated_ignores_test_labels():

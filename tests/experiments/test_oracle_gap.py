@@ -1,0 +1,42 @@
+"""``scripts/oracle_gap.py`` on a committed evaluation result: the recorded cut's F1, labelled cuts out of sample."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "scripts" / "oracle_gap.py"
+RESULT = ROOT / "docs" / "results" / "data" / "front_half" / "gift-dev5-inferred.json"
+
+
+def load_script():
+    spec = importlib.util.spec_from_file_location("oracle_gap_script", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_gap_reproduces_the_recorded_f1_and_orders_the_labelled_cuts():
+    mod = load_script()
+    res, kernel, rows = mod.intents_of(str(RESULT))
+    assert kernel == "gift-prob" and len(rows) == len(res["kernels"]["gift-prob"]["intents"])
+    g = mod.gap(rows, splits=20)
+    recorded = res["kernels"]["gift-prob"]["overall"]
+    assert g["train_calibrated"] == pytest.approx(recorded["train-calibrated"]["all"]["f1"])
+    assert g["oracle"] == pytest.approx(recorded["oracle"]["all"]["f1"])
+    # out of sample a labelled cut cannot beat the in-sample maximum on the same objects
+    assert g["leave_one_out"] <= g["oracle"] + 1e-12 and g["half_labelled"] <= g["half_oracle"] + 1e-12
+    assert g["test_objects"] == sum(len(r[1]) for r in rows)
+
+
+def test_a_suite_changed_since_the_run_is_refused(tmp_path):
+    res = json.loads(RESULT.read_text(encoding="utf-8"))
+    res["manifest"]["suite"]["sha256"] = "0" * 64
+    path = tmp_path / "changed.json"
+    path.write_text(json.dumps(res), encoding="utf-8")
+    with pytest.raises(SystemExit, match="has changed since the run"):
+        load_script().intents_of(str(path))
