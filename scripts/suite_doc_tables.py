@@ -23,6 +23,8 @@ DEV4_LABEL = {"headwear": "g1a", "feathered_things": "g1b", "stone_things": "g2a
               "baby_things": "g3a", "gym_kit": "g3b", "keys": "g4a", "measuring_tools": "g4b"}
 DEV5_LABEL = {"mirrored_things": "h1a", "chocolate": "h1b", "seashells": "h2a", "cordage": "h2b",
               "footwear": "h3a", "magic_props": "h3b", "cutlery": "h4a", "adhesives": "h4b"}
+DEV6_LABEL = {"cheeses": "i1a", "bee_products": "i1b", "dried_flowers": "i2a", "smoking_things": "i2b",
+              "alcoholic_drinks": "i3a", "cycling_kit": "i3b", "fire_lighting": "i4a", "openers": "i4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -73,6 +75,7 @@ def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
     paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
     dev3, dev4, dev5 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4"), gift.load_suite("gift-dev5")
+    dev6 = gift.load_suite("gift-dev6")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
@@ -85,12 +88,15 @@ def main() -> None:
     doc = put(doc, "gift-dev4:intents", intent_tables(dev4, DEV4_LABEL))
     doc = put(doc, "gift-dev5:summary", summary(dev5, DEV5_LABEL, "label"))
     doc = put(doc, "gift-dev5:intents", intent_tables(dev5, DEV5_LABEL))
+    doc = put(doc, "gift-dev6:summary", summary(dev6, DEV6_LABEL, "label"))
+    doc = put(doc, "gift-dev6:intents", intent_tables(dev6, DEV6_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
     doc = catalog_size(doc, "gift-dev", len(dev.objects))
     doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
     doc = catalog_size(doc, "gift-dev3", len(dev3.objects))
     doc = catalog_size(doc, "gift-dev4", len(dev4.objects))
     doc = catalog_size(doc, "gift-dev5", len(dev5.objects))
+    doc = catalog_size(doc, "gift-dev6", len(dev6.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

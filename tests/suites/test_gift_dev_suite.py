@@ -1,5 +1,5 @@
-"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4`` and ``gift-dev5``: new
-intents and objects, none borrowed from the suites they are checked against.
+"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5`` and
+``gift-dev6``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -65,6 +65,18 @@ DEV_SUITES = {
                        r"|magic|magician|conjur|illusion|\btricks?\b|\bprops?\b"
                        r"|cutlery|silverware|flatware|utensil|\bforks?\b|\bspoons?\b|\bknife|\bknives"
                        r"|adhesi|\bglues?\b|\bgluing\b|\bsticky\b|\bsticking\b|\btapes?\b|\bpastes?\b",
+    },
+    "gift-dev6": {
+        "siblings": [("cheeses", "bee_products"), ("dried_flowers", "smoking_things"),
+                     ("alcoholic_drinks", "cycling_kit"), ("fire_lighting", "openers")],
+        "label_words": r"chees|\bcurds?\b|dairy|\bbees?\b|honey|beeswax|\bhives?\b|apiar|apicult"
+                       r"|flower|floral|\bblooms?\b|blossom|petal|bouquet|\bposy|\bposies"
+                       r"|smok|tobacc|cigar|\bpipes?\b|nicotin"
+                       r"|alcohol|booze|boozy|\bbeers?\b|\bwines?\b|\bspirits?\b|liquor|liqueur|\blagers?\b|\bales?\b"
+                       r"|whiske?y|whiskies|vodka|\bgin\b|\brum\b|brandy"
+                       r"|\bbikes?\b|bicycl|cycl|\brid(?:e|es|ing)\b|\bpedal"
+                       r"|\bmatch(?:es|box|book|sticks?)?\b|\blighters?\b|\bfires?\b|firelight|\bflames?\b"
+                       r"|\bignit|\bkindl|\btinder\b|\bopen|uncork",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
