@@ -211,11 +211,12 @@ def write(result: dict, md: Path) -> None:
                      f"{_fmt(best['win'][0])} -> {_fmt(best['win'][k2])} (random {_fmt(rand['win'][k2])}).")
         if "without_rescore" in r:
             w = r["without_rescore"]
-            wb = max(qc.POLICIES, key=lambda p: w[p]["f1"][k2])
+            pols = qc.ran_policies(w)
+            wb = max(pols, key=lambda p: w[p]["f1"][k2])
             lines.append(f"  Without re-scoring (answers only re-threshold), the same sessions: best after 2 questions "
                          f"{w[wb]['f1'][k2]:.3f} (`{wb}`), random {w[qc.BASELINE]['f1'][k2]:.3f}; after 1 question "
-                         f"best {max(w[p]['f1'][grid.index(1)] for p in qc.POLICIES):.3f} against "
-                         f"{max(r['curves'][p]['f1'][grid.index(1)] for p in qc.POLICIES):.3f} with it."
+                         f"best {max(w[p]['f1'][grid.index(1)] for p in pols):.3f} against "
+                         f"{max(r['curves'][p]['f1'][grid.index(1)] for p in pols):.3f} with it."
                          if 1 in grid else
                          f"  Without re-scoring: best after 2 questions {w[wb]['f1'][k2]:.3f} (`{wb}`).")
     paper_inferred = [r for r in result["runs"].values()
@@ -223,7 +224,7 @@ def write(result: dict, md: Path) -> None:
     if paper_inferred:
         r = paper_inferred[0]
         k2 = r["grid"].index(2)
-        f1 = max(r["curves"][p]["f1"][k2] for p in qc.POLICIES)
+        f1 = max(r["curves"][p]["f1"][k2] for p in qc.ran_policies(r["curves"]))
         lines.append(f"- Target 1 (inferred intents, `gift-paper`, at most 2 questions per intent: F1 >= 0.90): "
                      f"{f1:.3f}, {'met' if f1 >= 0.90 else 'not met'}.")
         if r.get("bound"):
@@ -254,11 +255,12 @@ def write(result: dict, md: Path) -> None:
             if r["intent_source"] != source:
                 continue
             grid = r["grid"]
+            pols = qc.ran_policies(r["curves"])
             n = sum(i["n_test"] for i in r["intents"].values())
             lines += [f"### `{r['suite']}` ({len(r['intents'])} intents, {n} test objects)", "",
                       "Pooled F1 / mean win rate after k questions per intent:", "",
                       "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
-            for policy in qc.POLICIES + (qc.BASELINE,):
+            for policy in pols + (qc.BASELINE,):
                 c = r["curves"][policy]
                 cells = []
                 for j in range(len(grid)):
@@ -282,13 +284,13 @@ def write(result: dict, md: Path) -> None:
                 lines += ["", "The first cut rule tried, the widest-gap midpoint of the evidence (`move=\"widest\"`, "
                           "dropped, see `gift.core.queries`), pooled F1 after k questions:", "",
                           "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
-                for policy in qc.POLICIES + (qc.BASELINE,):
+                for policy in pols + (qc.BASELINE,):
                     lines.append(f"| {policy} | " + " | ".join(_fmt(v) for v in r["widest"][policy]["f1"]) + " |")
             if "without_rescore" in r:
                 lines += ["", "The same sessions with answers that only re-threshold the first scores (no re-scoring, "
                           "rule 5 off), pooled F1 / mean win rate after k questions:", "",
                           "| policy | " + " | ".join(f"k = {k}" for k in grid) + " |", "|---" * (len(grid) + 1) + "|"]
-                for policy in qc.POLICIES + (qc.BASELINE,):
+                for policy in pols + (qc.BASELINE,):
                     c = r["without_rescore"][policy]
                     lines.append(f"| {policy} | " + " | ".join(f"{_fmt(c['f1'][j])} / {_fmt(c['win'][j])}"
                                                              for j in range(len(grid))) + " |")
@@ -296,21 +298,21 @@ def write(result: dict, md: Path) -> None:
                       "distractors; F1 counts them as not aligned, *F1 decided* leaves them out):", "",
                       "| band | flagged objects | F1 (pooled) | F1 decided (mean over intents) | win rate |",
                       "|---|---|---|---|---|",
-                      f"| 0 | 0 | {_fmt(r['curves'][qc.POLICIES[0]]['f1'][0])} | "
-                      f"{_fmt(r['curves'][qc.POLICIES[0]]['f1_mean_intent'][0])} | "
-                      f"{_fmt(r['curves'][qc.POLICIES[0]]['win'][0])} |"]
+                      f"| 0 | 0 | {_fmt(r['curves'][pols[0]]['f1'][0])} | "
+                      f"{_fmt(r['curves'][pols[0]]['f1_mean_intent'][0])} | "
+                      f"{_fmt(r['curves'][pols[0]]['win'][0])} |"]
             for band, a in r["abstention"].items():
                 lines.append(f"| {band} | {a['abstained']} | {_fmt(a['f1'])} | {_fmt(a['f1_decided_mean_intent'])} | "
                              f"{_fmt(a['win'])} |")
             lines += ["", "Per intent: F1 at k = 0 and after 2 questions, and the first questions each policy asks:", "",
-                      "| intent | relevant / test | F1 k=0 | " + " | ".join(f"{p} k=2" for p in qc.POLICIES) +
-                      " | random k=2 | asked first (uncertainty) | note |", "|---" * (6 + len(qc.POLICIES)) + "|"]
+                      "| intent | relevant / test | F1 k=0 | " + " | ".join(f"{p} k=2" for p in pols) +
+                      f" | random k=2 | asked first ({pols[0]}) | note |", "|---" * (6 + len(pols)) + "|"]
             k2 = grid.index(2)
             for i, info in r["intents"].items():
                 pi = r["per_intent"]
-                lines.append(f"| `{i}` | {info['n_relevant']} / {info['n_test']} | {pi['uncertainty'][i]['f1'][0]:.2f} | "
-                             + " | ".join(f"{pi[p][i]['f1'][k2]:.2f}" for p in qc.POLICIES)
-                             + f" | {pi['random'][i]['f1'][k2]:.2f} | {', '.join(pi['uncertainty'][i]['asked'][:2])} | "
+                lines.append(f"| `{i}` | {info['n_relevant']} / {info['n_test']} | {pi[pols[0]][i]['f1'][0]:.2f} | "
+                             + " | ".join(f"{pi[p][i]['f1'][k2]:.2f}" for p in pols)
+                             + f" | {pi['random'][i]['f1'][k2]:.2f} | {', '.join(pi[pols[0]][i]['asked'][:2])} | "
                              f"{info['note'] or ''} |")
             lines.append("")
     if result["failures"]:

@@ -86,3 +86,12 @@ def test_the_figure_draws_every_run(tmp_path):
     path = qc.figure({"suite A": sim, "suite B": sim}, tmp_path / "curves.png", title="t")
     assert path.stat().st_size > 10_000 and path.read_bytes()[:4] == b"\x89PNG"
     assert np.isfinite(sim["curves"]["random"]["f1_se"][1])
+
+
+def test_a_run_with_some_of_the_policies_draws_and_reports_only_those(tmp_path):
+    sim = qc.simulate(DATA, random_seeds=2, bands=(), policies=("disagreement",))
+    assert set(sim["curves"]) == {"disagreement", "random"}
+    assert qc.ran_policies(sim["curves"]) == ("disagreement",)
+    assert qc.target_check(sim)["best"] == "disagreement"
+    path = qc.figure({"suite A": sim}, tmp_path / "curves.png")
+    assert path.stat().st_size > 10_000

@@ -212,6 +212,12 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
             "bound": bound}
 
 
+def ran_policies(curves: Mapping[str, Any]) -> tuple[str, ...]:
+    """The policies (not ``random``) a run's ``curves`` hold: those of :data:`POLICIES` in that order, then any
+    other (a run may ask with a subset, ``--policies``)."""
+    return tuple(p for p in POLICIES if p in curves) + tuple(p for p in curves if p not in POLICIES + (BASELINE,))
+
+
 def queries_to_reach(grid: Sequence[int], values: Sequence[float | None], target: float) -> float | None:
     """The number of questions at which a curve first reaches ``target`` (linear between grid points);
     None when it does not within the grid."""
@@ -232,7 +238,7 @@ def target_check(sim: Mapping[str, Any], at: Sequence[int] = (1, 2, 4)) -> dict[
     reaches and the number of questions random needs to reach it."""
     grid = sim["grid"]
     k2 = grid.index(2)
-    run = [p for p in POLICIES if p in sim["curves"]]
+    run = list(ran_policies(sim["curves"]))
     best = max(run, key=lambda p: (sim["curves"][p]["f1"][k2], -run.index(p)))
     rows = []
     for k in (k for k in at if k in grid):
@@ -260,12 +266,12 @@ def figure(runs: Mapping[str, Mapping[str, Any]], path: Path, title: str = "") -
         grid = sim["grid"]
         for r, (key, name) in enumerate((("f1", "alignment F1 (pooled)"), ("win", "win rate (mean over intents)"))):
             ax = axes[r][c]
-            for policy in POLICIES + (BASELINE,):
+            for policy in ran_policies(sim["curves"]) + (BASELINE,):
                 vals = sim["curves"][policy][key]
                 if all(v is None for v in vals):
                     continue
                 y = np.array([np.nan if v is None else v for v in vals], dtype=float)
-                color, marker = styles[policy]
+                color, marker = styles.get(policy, ("tab:purple", "d"))
                 ax.plot(grid, y, marker=marker, color=color, label=policy, linestyle="--" if policy == BASELINE else "-")
                 se = sim["curves"][policy].get(key + "_se")
                 if se:
