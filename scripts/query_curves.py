@@ -144,6 +144,10 @@ def provenance(result: dict) -> str:
     return "Merged from runs at " + "; ".join(f"{one(p)} ({p.get('seconds') or 0:.0f} s)" for p in parts)
 
 
+#: In an existing page, the text from this line on was written by hand and is kept when the page is regenerated.
+KEEP = "<!-- written by hand: kept when scripts/query_curves.py regenerates the page above -->"
+
+
 def write(result: dict, md: Path) -> None:
     from gift.core.serialization import write_json
     from gift_experiments import query_curves as qc
@@ -329,7 +333,12 @@ def write(result: dict, md: Path) -> None:
               "- The issue's targets: with at most 2 questions per intent, inferred-intent F1 of at least 0.90 on "
               "`gift-paper`; the best policy needing at most half the questions random needs for the same F1 "
               "(a ratio of 0.5 or less in the tables above).", ""]
-    md.write_text("\n".join(lines), encoding="utf-8")
+    kept = ""
+    if md.exists():  # sections written by hand after the generated page stay (from the marker on)
+        old = md.read_text(encoding="utf-8")
+        if KEEP in old:
+            kept = old[old.index(KEEP):]
+    md.write_text("\n".join(lines) + ("\n" + kept if kept else ""), encoding="utf-8")
 
 
 def qc_grid() -> tuple[int, ...]:

@@ -38,3 +38,19 @@ def test_a_merged_page_names_the_commit_and_code_version_of_each_part(script):
     other["lm"] = {"model_sha256": "other"}
     with pytest.raises(SystemExit, match="different LM model files"):
         script.merge([_run("a" * 40, "1" * 16, "s1", 1.0), other])
+
+
+def test_regenerating_a_page_keeps_what_was_written_by_hand_after_the_marker(script, tmp_path):
+    import json
+
+    saved = Path(__file__).resolve().parents[2] / "docs" / "results" / "queries" / "curves.json"
+    result = json.loads(saved.read_text(encoding="utf-8"))
+    md = tmp_path / "queries.md"
+    script.write(result, md)
+    generated = md.read_text(encoding="utf-8")
+    assert script.KEEP not in generated and "## In short" in generated
+    md.write_text(generated + "\n" + script.KEEP + "\n\n## A decision\n\nWritten by hand.\n", encoding="utf-8")
+    script.write(result, md)
+    again = md.read_text(encoding="utf-8")
+    assert again.startswith(generated) and again.endswith(script.KEEP + "\n\n## A decision\n\nWritten by hand.\n")
+    assert again.count("## In short") == 1
