@@ -128,6 +128,10 @@ RELEVANCE_TEMPLATES: dict[str, str] = {
     "about": "Goal: {goal}.\nDoes this goal concern a {name}{desc}? Answer yes or no.",
     # Without the description (names only).
     "goal-name": "Goal: {goal}.\nIs a {name} one of the things this goal is about? Answer yes or no.",
+    # The category question, told that a thing used with, holding or named after the category is not one of it
+    # (against distractors named like the class: a grater for cheese; docs/results/front_half.md, section 18).
+    "kind": ("Is a {name}{desc} itself one of the {category}? A thing only used with them, made to hold them or "
+             "sharing a word with them is not. Answer yes or no."),
 }
 
 AXIS_TEMPLATE = "{question}\nThe object: a {name}{desc}. Answer yes or no."
