@@ -259,6 +259,16 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
                        combine="none").score(TEST, TRAIN, ART, relevant_train=("ghost",))
 
 
+def test_every_relevance_template_asks_one_yes_no_question_about_the_object():
+    obj = gift.ObjectSpec("cheese grater", description="a steel box with rasps")
+    for name, template in prompts.RELEVANCE_TEMPLATES.items():
+        system, user = prompts.relevance_messages(obj, "keep the mug away from the cheese", name, category="cheeses")
+        assert system.role == "system" and user.content.endswith("Answer yes or no.") and "cheese grater" in user.content
+        assert ("cheeses" in user.content) == ("{category}" in template)
+    kind = prompts.relevance_messages(obj, "keep the mug away from the cheese", "kind", category="cheeses")[1].content
+    assert "(a steel box with rasps)" in kind and "itself one of the cheeses" in kind
+
+
 def test_goal_text_turns_motivation_sentences_into_goal_clauses():
     assert prompts.goal_text("The human prefers to keep sharp tools away from food.") == \
         "keep sharp tools away from food"
