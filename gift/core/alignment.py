@@ -41,7 +41,8 @@ Thresholds (``threshold=``)
   balanced accuracy; ties: the widest gap). No test label is used. Matrix kernels reuse
   ``K(train, train)`` with the diagonal masked; relevance kernels return the scores from their one
   pass. A relevant object with no relevant partner left is not a usable positive. With no positive or
-  no negative left it falls back to ``non-oracle`` and says so in the note. A relevance kernel whose
+  no negative left it falls back to the kernel's prior cut (below) when it has one, else to
+  ``non-oracle``, and says so in the note. A relevance kernel whose
   scores are calibrated probabilities with the training evidence already folded in
   (``RelevanceScores.cut``, e.g. gift-prob with ``calibration="pooled"``) gives the cut itself: 1/2. A
   relevance kernel whose scale has a boundary of its own (``RelevanceScores.prior_cut``, e.g. gift-prob's
@@ -372,6 +373,9 @@ class AlignmentScores:
             pos = self.loo_scores[usable & self.loo_labels]
             neg = self.loo_scores[usable & ~self.loo_labels]
             if pos.size == 0 or neg.size == 0:
+                if self.prior_cut is not None and self.prior_weight > 0.0:
+                    return float(self.prior_cut), (f"the kernel's prior cut {self.prior_cut:g} alone: leave-one-out "
+                                                   f"gave {pos.size} positive and {neg.size} negative scores")
                 if self.train_mean is None:
                     raise GiftError("train-calibrated threshold: the training objects give no positive or no "
                                     "negative leave-one-out score, and no K(train, train) mean to fall back on")

@@ -76,6 +76,19 @@ def test_answers_move_the_cut_from_the_averaged_one_with_move_nearest_and_leave_
         assert answered_cut(s, "train-calibrated", answers)[0] == pytest.approx(anchor)
 
 
+def test_without_a_leave_one_out_cut_the_prior_cut_stands_alone_not_the_mean_over_training_pairs():
+    # one relevant training object: no usable positive is left for the leave-one-out cut
+    def one(**prior):
+        return score_alignment(Fixed(**prior), [ObjectSpec(n) for n in TEST], [ObjectSpec(n) for n in TRAIN],
+                               relevant_train=("a",), need=("train-calibrated", "non-oracle"))
+    cut, note = one(prior_cut=0.6, prior_weight=0.25).threshold("train-calibrated")
+    assert cut == 0.6 and "prior cut 0.6 alone: leave-one-out gave 0 positive and 3 negative" in note
+    # no prior (or weight 0): the old fallback to the mean over training pairs, said so
+    for prior in ({}, {"prior_cut": 0.6, "prior_weight": 0.0}):
+        cut, note = one(**prior).threshold("train-calibrated")
+        assert cut == one().threshold("non-oracle")[0] and note.startswith("fallback to non-oracle")
+
+
 @pytest.mark.parametrize("bad", [{"prior_cut": 1.5}, {"prior_cut": -0.1}, {"prior_weight": 2.0},
                                  {"prior_cut": "half"}])
 def test_a_prior_outside_the_unit_interval_is_refused_by_name(bad):
