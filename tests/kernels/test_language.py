@@ -52,6 +52,25 @@ def test_descriptions_change_what_is_embedded(kernel):
         gift.get_kernel("language", use_descriptions="yes")
 
 
+def test_descriptions_alone_leave_the_name_out():
+    alone = gift.get_kernel("language", use_descriptions=True, names=False)
+    assert language.object_text(OBJ["banana"], True, names=False) == "a ripe yellow fruit"
+    assert language.object_text(ObjectSpec("widget"), True, names=False) == "widget"  # no description: the name
+    # two things named alike but described apart: the description alone tells them apart, the name pulls them together
+    grater = ObjectSpec("cheese grater", "a four-sided steel box with rasps for shredding")
+    cheddar = ObjectSpec("wedge of cheddar", "a firm crumbly orange block made from cow's milk")
+    both = gift.get_kernel("language", use_descriptions=True)
+    assert alone.similarity([grater], [cheddar])[0, 0] < both.similarity([grater], [cheddar])[0, 0]
+    same = [ObjectSpec("thing one", "a round red fruit"), ObjectSpec("other name", "a round red fruit")]
+    assert alone.similarity(same[:1], same[1:])[0, 0] == pytest.approx(1.0, abs=1e-5)
+    with pytest.raises(gift.GiftError, match="names=False embeds the descriptions alone"):
+        gift.get_kernel("language", names=False)
+    # gift-prob's MiniLM term reads the descriptions alone with embed_text="description"
+    from gift_kernels.lm_kernels import GiftProbKernel
+    assert GiftProbKernel(embed_text="description").language.names is False
+    assert GiftProbKernel().language.names is True
+
+
 def test_embeddings_are_cached_on_disk(tmp_path, monkeypatch):
     monkeypatch.setenv("GIFT_CACHE_DIR", str(tmp_path))
     cache = EmbeddingCache("test-model")

@@ -250,7 +250,7 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
     with pytest.raises(GiftError, match="conditions on an intent"):
         GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).score(TEST, TRAIN, None)
     for bad in ({"template": "nope"}, {"combine": "mean"}, {"weight": 2.0}, {"embed_reference": "x"},
-                {"standardize": "y"}):
+                {"standardize": "y"}, {"embed_text": "name"}):
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):

@@ -58,10 +58,11 @@ def embed_texts(texts: Sequence[str]) -> np.ndarray:
     return _cache.embed(list(texts), compute)
 
 
-def object_text(obj: ObjectSpec, use_descriptions: bool) -> str:
-    """What gets embedded: the name, or ``"name: description"`` (the name alone when there is none)."""
+def object_text(obj: ObjectSpec, use_descriptions: bool, names: bool = True) -> str:
+    """What gets embedded: the name, or ``"name: description"`` (the name alone when there is none); with
+    ``names=False`` and a description, the description alone."""
     if use_descriptions and obj.description.strip():
-        return f"{obj.name}: {obj.description.strip()}"
+        return f"{obj.name}: {obj.description.strip()}" if names else obj.description.strip()
     return obj.name
 
 
@@ -76,20 +77,25 @@ class LanguageKernel(SimilarityKernel):
     name: ClassVar[str] = "language"
     uses_intent: ClassVar[bool] = False
 
-    def __init__(self, use_descriptions: bool = False) -> None:
-        if not isinstance(use_descriptions, bool):
-            raise GiftError(f"language kernel: use_descriptions must be true or false, got {use_descriptions!r}")
-        self.use_descriptions = use_descriptions
+    def __init__(self, use_descriptions: bool = False, names: bool = True) -> None:
+        for key, value in (("use_descriptions", use_descriptions), ("names", names)):
+            if not isinstance(value, bool):
+                raise GiftError(f"language kernel: {key} must be true or false, got {value!r}")
+        if not names and not use_descriptions:
+            raise GiftError("language kernel: names=False embeds the descriptions alone, so it needs "
+                            "use_descriptions=True")
+        #: ``names=False``: embed an object's description without its name (the name when it has none)
+        self.use_descriptions, self.names = use_descriptions, names
 
     def __repr__(self) -> str:
-        return f"LanguageKernel(use_descriptions={self.use_descriptions})"
+        return f"LanguageKernel(use_descriptions={self.use_descriptions}, names={self.names})"
 
     def similarity(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec],
                    intent: Intent | None = None) -> np.ndarray:
         """``[n_test, n_train]`` in [0, 1]; the intent is ignored (a surface kernel)."""
         if not test or not train:
             return np.zeros((len(test), len(train)))
-        emb = embed_texts([object_text(o, self.use_descriptions) for o in (*test, *train)])
+        emb = embed_texts([object_text(o, self.use_descriptions, self.names) for o in (*test, *train)])
         return cosine_to_unit(cosine(emb[:len(test)], emb[len(test):]))
 
     @staticmethod

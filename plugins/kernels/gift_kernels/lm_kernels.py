@@ -231,6 +231,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 
 COMBINE = ("none", "language")
 EMBED_REFERENCE = ("relevant", "contrastive")
+EMBED_TEXT = ("name+description", "description")
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
@@ -281,7 +282,7 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    object), ``embed_text`` (what MiniLM embeds: ``"name+description"`` or ``"description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
@@ -309,13 +310,20 @@ class GiftProbKernel(RelevanceKernel):
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
-                 ladder: str | None = None, rungs: str = "both", check: str = "fit") -> None:
+                 ladder: str | None = None, rungs: str = "both", check: str = "fit",
+                 embed_text: str = "name+description") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
             raise GiftError(f"gift-prob: combine must be one of {COMBINE}, got {combine!r}")
         if embed_reference not in EMBED_REFERENCE:
             raise GiftError(f"gift-prob: embed_reference must be one of {EMBED_REFERENCE}, got {embed_reference!r}")
+        if embed_text not in EMBED_TEXT:
+            raise GiftError(f"gift-prob: embed_text must be one of {EMBED_TEXT}, got {embed_text!r}")
+        #: What the MiniLM term embeds of each object: ``"name+description"`` (the default) or
+        #: ``"description"`` (the name left out, so the LM's question, which carries the name, and the MiniLM
+        #: term do not both read it; a distractor named like the class is then judged by what it is).
+        self.embed_text = embed_text
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
@@ -406,7 +414,8 @@ class GiftProbKernel(RelevanceKernel):
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
-                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r})")
+                f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
+                f"embed_text={self.embed_text!r})")
 
     # ------------------------------------------------------------------ pieces
     @property
@@ -425,14 +434,16 @@ class GiftProbKernel(RelevanceKernel):
     def language(self) -> SimilarityKernel:
         if self._language is None:
             import gift
+
+            names = self.embed_text != "description"
             from gift.core.errors import UnknownComponentError
 
             try:
-                self._language = gift.get_kernel("language", use_descriptions=True)
+                self._language = gift.get_kernel("language", use_descriptions=True, names=names)
             except UnknownComponentError:  # the plugin's registration not loaded (e.g. GIFT_PLUGINS filter)
                 from gift_kernels.language import LanguageKernel
 
-                self._language = LanguageKernel(use_descriptions=True)
+                self._language = LanguageKernel(use_descriptions=True, names=names)
         return self._language
 
     def _ask(self, messages: tuple[Message, ...]) -> float:
