@@ -1,0 +1,165 @@
+"""Re-score saved gift-prob runs under other ways of combining its two terms, without the LM.
+
+A ``gift evaluate-alignment --out`` result keeps, per intent, gift-prob's LM term (the log-odds, or with the
+ladder the mixed z-scores) for every test and held-out training object. The MiniLM term is cheap to recompute.
+This rebuilds each scene's relevance with the kernel's own code (``GiftProbKernel._embed_scores`` and
+``_combine``) under each variant of the options that act *after* the LM (``embed_text``, ``weight``,
+``weighting``, ``embed_reference``, ``standardize``, ``combine``), places the train-calibrated cut with the core
+(``AlignmentScores.with_relevance``), and prints pooled F1 (train-calibrated and oracle cut), AUC and how many
+distractors named like the goal's class (``lang`` confounds) were aligned.
+
+The variant ``default`` (no option) must reproduce the saved decisions: the script stops if any differs by more
+than 1e-5 (the file was made by other code, or its terms are not the kernel's).
+
+    python scripts/recombine_terms.py docs/results/data/front_half/gift-dev6-inferred.json \
+        --variant embed_text=description --variant weight=0.25 --out table.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from oracle_gap import load_recorded_suite  # noqa: E402  (this directory's script: the suite check)
+
+from gift.core.alignment import AlignmentScores, oracle_cut  # noqa: E402
+from gift.core.metrics import binary_metrics, roc_auc  # noqa: E402
+
+AFTER_LM = {"embed_text": str, "weight": float, "weighting": str, "embed_reference": str, "standardize": str,
+            "combine": str}
+
+
+def parse_variant(text: str) -> tuple[str, dict]:
+    """``"key=value,key=value"`` (or ``"default"``) -> ``(label, kwargs)`` of options that act after the LM."""
+    if text == "default":
+        return text, {}
+    out = {}
+    for part in text.split(","):
+        key, sep, value = part.partition("=")
+        if not sep or key not in AFTER_LM:
+            raise SystemExit(f"--variant {text!r}: each part is key=value with key one of {sorted(AFTER_LM)} "
+                             f"(options that act after the LM), got {part!r}")
+        out[key] = AFTER_LM[key](value)
+    return text, out
+
+
+def kernel_records(res: dict, path: str, kernel: str | None = None) -> tuple[str, dict]:
+    """The first of ``kernel`` (comma-separated names) found in the file, else its first gift-prob* kernel."""
+    prefer = [k for k in (kernel or "").split(",") if k]
+    names = [k for k in prefer if k in res["kernels"]] or \
+        ([] if prefer else [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"])
+    if not names:
+        raise SystemExit(f"{path}: none of the kernels {prefer or ['gift-prob*']} among {sorted(res['kernels'])}")
+    return names[0], res["kernels"][names[0]]["intents"]
+
+
+def base_options(kernel_name: str) -> dict:
+    """The options of a kernel spec ``"gift-prob:a=b,c=d"`` that this script can rebuild (others are LM-side)."""
+    opts = {}
+    for part in filter(None, kernel_name.partition(":")[2].split(",")):
+        key, _, value = part.partition("=")
+        if key in AFTER_LM:
+            opts[key] = AFTER_LM[key](value)
+    return opts
+
+
+def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = None) -> dict[str, dict]:
+    """Per variant: pooled counts ``tp, fp, fn`` (train-calibrated and oracle), per-intent AUCs and aligned
+    ``lang`` distractors, for one result file."""
+    from gift_kernels.lm_kernels import GiftProbKernel, _sigmoid
+
+    res = json.loads(Path(path).read_text(encoding="utf-8"))
+    suite = load_recorded_suite(res, path)
+    kname, intents = kernel_records(res, path, kernel)
+    base = base_options(kname)
+    out = {label: {"tc": np.zeros(3), "oracle": np.zeros(3), "auc": [], "lang": [0, 0]} for label, _ in variants}
+    for iid, rec in intents.items():
+        sc, det = rec["scores"], rec["details"]
+        if "terms" not in det:
+            raise SystemExit(f"{path}: intent {iid!r} has no saved terms (a run older than the terms record)")
+        scores = AlignmentScores.from_dict(sc)
+        objs = suite.objects
+        test, train = [objs[n] for n in sc["test"]], [objs[n] for n in sc["train"]]
+        rel = np.asarray(scores.relevant_mask, dtype=bool)
+        items = {t.object: t for t in suite.intent(iid).test}
+        y = np.array([items[n].relevant for n in sc["test"]], dtype=bool)
+        named = np.array(["lang" in items[n].confounds and not items[n].relevant for n in sc["test"]])
+        lo = np.asarray(det["terms"]["lm"]["test"] + det["terms"]["lm"]["train"], dtype=float)
+        for label, opts in variants:
+            k = GiftProbKernel(**{**base, **opts})
+            if k.combine == "none":
+                p = _sigmoid(lo)
+            else:
+                emb = np.concatenate([k._embed_scores(test, train, rel, False),
+                                      k._embed_scores(train, train, rel, True)])
+                p = _sigmoid(k._combine(lo, emb, rel, len(test))[0])
+            if label == "default":
+                dev = float(np.abs(p[: len(test)] - np.asarray(sc["decision"])).max(initial=0.0))
+                if dev > 1e-5:
+                    raise SystemExit(f"{path}: intent {iid!r}: the default re-combination differs from the saved "
+                                     f"decision by {dev:.2e}; this file was not made by this code's gift-prob")
+            view = scores.with_relevance(p[: len(test)], p[len(test):])
+            pred = view.predicted_relevant(view.threshold("train-calibrated")[0])
+            o = out[label]
+            for key, predicted in (("tc", pred), ("oracle", p[: len(test)] >= oracle_cut(p[: len(test)], y))):
+                m = binary_metrics(predicted, y)
+                o[key] += (m.tp, m.fp, m.fn)
+            if y.any() and (~y).any():
+                o["auc"].append(roc_auc(p[: len(test)], y))
+            o["lang"][0] += int((pred & named).sum())
+            o["lang"][1] += int(named.sum())
+    return out
+
+
+def f1(c: np.ndarray) -> float:
+    return float(2 * c[0] / (2 * c[0] + c[1] + c[2])) if c[0] else 0.0
+
+
+def table(rows: dict[str, dict[str, dict]], variants: list[str]) -> str:
+    head = "| file | " + " | ".join(variants) + " |"
+    lines = [head, "|" + "---|" * (len(variants) + 1)]
+    pooled = {v: {"tc": np.zeros(3), "oracle": np.zeros(3), "lang": [0, 0]} for v in variants}
+    for path, per in rows.items():
+        cells = []
+        for v in variants:
+            o = per[v]
+            cells.append(f"{f1(o['tc']):.3f} / {f1(o['oracle']):.3f} / {np.mean(o['auc']):.3f} "
+                         f"({o['lang'][0]}/{o['lang'][1]})")
+            pooled[v]["tc"] += o["tc"]
+            pooled[v]["oracle"] += o["oracle"]
+            pooled[v]["lang"] = [a + b for a, b in zip(pooled[v]["lang"], o["lang"])]
+        lines.append(f"| {Path(path).name} | " + " | ".join(cells) + " |")
+    if len(rows) > 1:
+        lines.append("| **pooled** | " + " | ".join(
+            f"{f1(pooled[v]['tc']):.3f} / {f1(pooled[v]['oracle']):.3f} / - "
+            f"({pooled[v]['lang'][0]}/{pooled[v]['lang'][1]})" for v in variants) + " |")
+    return "\n".join(lines) + ("\n\nEach cell: train-calibrated F1 / oracle-cut F1 / mean AUC (aligned named-alike "
+                               "distractors / all of them), pooled over the file's test objects.\n")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("files", nargs="+", help="gift evaluate-alignment --out JSON files with a gift-prob kernel")
+    ap.add_argument("--variant", action="append", default=[],
+                    help="options acting after the LM, e.g. embed_text=description or weight=0.25,combine=language "
+                         "(repeatable; 'default' is always included)")
+    ap.add_argument("--kernel", help="comma-separated kernel names; the first one in each file is read "
+                                     "(default: the file's first gift-prob* kernel)")
+    ap.add_argument("--out", help="also write the table (Markdown) here")
+    args = ap.parse_args(argv)
+    variants = [parse_variant("default")] + [parse_variant(v) for v in args.variant if v != "default"]
+    rows = {p: rescore(p, variants, args.kernel) for p in args.files}
+    text = table(rows, [label for label, _ in variants])
+    sys.stdout.write(text)
+    if args.out:
+        Path(args.out).write_text(text, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
