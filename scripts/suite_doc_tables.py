@@ -25,6 +25,8 @@ DEV5_LABEL = {"mirrored_things": "h1a", "chocolate": "h1b", "seashells": "h2a", 
               "footwear": "h3a", "magic_props": "h3b", "cutlery": "h4a", "adhesives": "h4b"}
 DEV6_LABEL = {"cheeses": "i1a", "bee_products": "i1b", "dried_flowers": "i2a", "smoking_things": "i2b",
               "alcoholic_drinks": "i3a", "cycling_kit": "i3b", "fire_lighting": "i4a", "openers": "i4b"}
+DEV7_LABEL = {"citrus_fruit": "j1a", "awards": "j1b", "sugar": "j2a", "mushrooms": "j2b",
+              "handwear": "j3a", "table_tennis": "j3b", "drinking_straws": "j4a", "table_mats": "j4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -75,7 +77,7 @@ def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
     paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
     dev3, dev4, dev5 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4"), gift.load_suite("gift-dev5")
-    dev6 = gift.load_suite("gift-dev6")
+    dev6, dev7 = gift.load_suite("gift-dev6"), gift.load_suite("gift-dev7")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
@@ -90,6 +92,8 @@ def main() -> None:
     doc = put(doc, "gift-dev5:intents", intent_tables(dev5, DEV5_LABEL))
     doc = put(doc, "gift-dev6:summary", summary(dev6, DEV6_LABEL, "label"))
     doc = put(doc, "gift-dev6:intents", intent_tables(dev6, DEV6_LABEL))
+    doc = put(doc, "gift-dev7:summary", summary(dev7, DEV7_LABEL, "label"))
+    doc = put(doc, "gift-dev7:intents", intent_tables(dev7, DEV7_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
     doc = catalog_size(doc, "gift-dev", len(dev.objects))
     doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
@@ -97,6 +101,7 @@ def main() -> None:
     doc = catalog_size(doc, "gift-dev4", len(dev4.objects))
     doc = catalog_size(doc, "gift-dev5", len(dev5.objects))
     doc = catalog_size(doc, "gift-dev6", len(dev6.objects))
+    doc = catalog_size(doc, "gift-dev7", len(dev7.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

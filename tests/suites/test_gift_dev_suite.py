@@ -1,5 +1,5 @@
-"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5`` and
-``gift-dev6``: new intents and objects, none borrowed from the suites they are checked against.
+"""The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
+``gift-dev6`` and ``gift-dev7``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -77,6 +77,15 @@ DEV_SUITES = {
                        r"|\bbikes?\b|bicycl|cycl|\brid(?:e|es|ing)\b|\bpedal"
                        r"|\bmatch(?:es|box|book|sticks?)?\b|\blighters?\b|\bfires?\b|firelight|\bflames?\b"
                        r"|\bignit|\bkindl|\btinder\b|\bopen|uncork",
+    },
+    "gift-dev7": {
+        "siblings": [("citrus_fruit", "awards"), ("sugar", "mushrooms"),
+                     ("handwear", "table_tennis"), ("drinking_straws", "table_mats")],
+        "label_words": r"citrus|citric|\bfruits?\b|lemon|\blimes?\b|\boranges?\b"
+                       r"|\bmedal|troph|\baward|\bprize"
+                       r"|\bsugar|sucrose|\bsweeten|mushroom|\bfung(?:us|i|al)\b|toadstool|\bmycel"
+                       r"|\bglov|mitten|\bmitts?\b|handwear|tennis|ping.?pong"
+                       r"|\bstraws?\b|drinking|\bsip(?:s|ped|ping)?\b|coaster|placemat|\bmats?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
