@@ -32,6 +32,8 @@ def test_the_default_reproduces_the_run_and_the_description_option_changes_it():
     # every intent of this run has 2+ inferred relevant objects, so the recorded cut is the prior 1/2 throughout
     assert mod.f1(out["default"]["tc"]) == pytest.approx(recorded["train-calibrated"]["all"]["f1"])
     assert mod.f1(out["default"]["oracle"]) == pytest.approx(recorded["oracle"]["all"]["f1"])
+    # a run made before the default changed: identified as name+description by reproducing its decisions
+    assert out["default"]["options"]["embed_text"] == "name+description"
     desc = out["embed_text=description"]
     assert not np.array_equal(desc["tc"], out["default"]["tc"]) or desc["auc"] != out["default"]["auc"]
     assert out["default"]["lang"][1] == desc["lang"][1] > 0  # the same named-alike distractors, counted
@@ -44,7 +46,7 @@ def test_a_file_not_made_by_this_gift_prob_and_bad_variants_are_refused(tmp_path
     rec["scores"]["decision"] = [min(1.0, d + 0.1) for d in rec["scores"]["decision"]]
     path = tmp_path / "edited.json"
     path.write_text(json.dumps(res), encoding="utf-8")
-    with pytest.raises(SystemExit, match="differs from the saved decision"):
+    with pytest.raises(SystemExit, match="reproduces the saved decisions"):
         mod.rescore(str(path), [mod.parse_variant("default")])
     with pytest.raises(SystemExit, match="options that act after the LM"):
         mod.parse_variant("template=kind")

@@ -65,10 +65,10 @@ def test_descriptions_alone_leave_the_name_out():
     assert alone.similarity(same[:1], same[1:])[0, 0] == pytest.approx(1.0, abs=1e-5)
     with pytest.raises(gift.GiftError, match="names=False embeds the descriptions alone"):
         gift.get_kernel("language", names=False)
-    # gift-prob's MiniLM term reads the descriptions alone with embed_text="description"
+    # gift-prob's MiniLM term reads the descriptions alone (embed_text="description", the default)
     from gift_kernels.lm_kernels import GiftProbKernel
-    assert GiftProbKernel(embed_text="description").language.names is False
-    assert GiftProbKernel().language.names is True
+    assert GiftProbKernel().language.names is False
+    assert GiftProbKernel(embed_text="name+description").language.names is True
 
 
 def test_embeddings_are_cached_on_disk(tmp_path, monkeypatch):

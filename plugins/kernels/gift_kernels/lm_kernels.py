@@ -270,8 +270,8 @@ class GiftProbKernel(RelevanceKernel):
     Default recipe (``docs/results/gift_prob.md``): the LM names the kind of object the goal is about
     from the goal and the training objects the demonstrations treat as part of it (one few-shot call per
     intent, plus one per training object with that object left out; :meth:`category`), then answers per
-    object "is a <object> (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM description
-    similarity are z-scored and averaged, each weighted by how well it separates the relevant training
+    object "is a <object> (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM similarity
+    of the descriptions (without the names) are z-scored and averaged, each weighted by how well it separates the relevant training
     objects from the others (leave-one-out; ``weighting="reliability"``). ``calibration="pooled"`` instead
     puts both terms through one logistic model fitted on pooled development-suite intents and updated with
     this intent's relevant training objects (cut 1/2); measured better with true intents, worse with
@@ -282,7 +282,7 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``embed_text`` (what MiniLM embeds: ``"name+description"`` or ``"description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
@@ -311,7 +311,7 @@ class GiftProbKernel(RelevanceKernel):
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
-                 embed_text: str = "name+description") -> None:
+                 embed_text: str = "description") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -320,9 +320,11 @@ class GiftProbKernel(RelevanceKernel):
             raise GiftError(f"gift-prob: embed_reference must be one of {EMBED_REFERENCE}, got {embed_reference!r}")
         if embed_text not in EMBED_TEXT:
             raise GiftError(f"gift-prob: embed_text must be one of {EMBED_TEXT}, got {embed_text!r}")
-        #: What the MiniLM term embeds of each object: ``"name+description"`` (the default) or
-        #: ``"description"`` (the name left out, so the LM's question, which carries the name, and the MiniLM
-        #: term do not both read it; a distractor named like the class is then judged by what it is).
+        #: What the MiniLM term embeds of each object: ``"description"`` (the default: the name left out, so
+        #: the LM's question, which carries the name, and the MiniLM term do not both read it; a distractor
+        #: named like the class is then judged by what it is) or ``"name+description"``. Chosen on gift-dev7
+        #: by a rule written before it was run (train-calibrated F1 0.767 -> 0.788 pooled over both intent
+        #: sources; docs/results/front_half.md, section 19).
         self.embed_text = embed_text
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
