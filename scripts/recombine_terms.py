@@ -121,8 +121,8 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
         raise SystemExit(f"{path}: no known set of gift-prob options reproduces the saved decisions (largest "
                          f"difference {min(worst)[0]:.2e}, intent {min(worst)[1]!r}); this file was not made by "
                          f"this code's gift-prob")
-    out = {label: {"tc": np.zeros(3), "oracle": np.zeros(3), "auc": [], "lang": [0, 0], "options": {**base, **o}}
-           for label, o in variants}
+    out = {label: {"tc": np.zeros(3), "oracle": np.zeros(3), "auc": [], "lang": [0, 0], "options": {**base, **o},
+                   "intents": {}} for label, o in variants}
     for iid, scores, test, train, rel, y, named, lo, _ in scenes:
         for label, opts in variants:
             p = _relevance({**base, **opts}, lo, test, train, rel)
@@ -132,6 +132,8 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
             for key, predicted in (("tc", pred), ("oracle", p[: len(test)] >= oracle_cut(p[: len(test)], y))):
                 m = binary_metrics(predicted, y)
                 o[key] += (m.tp, m.fp, m.fn)
+                if key == "tc":
+                    o["intents"][iid] = float(m.f1)
             if y.any() and (~y).any():
                 o["auc"].append(roc_auc(p[: len(test)], y))
             o["lang"][0] += int((pred & named).sum())
@@ -165,6 +167,19 @@ def table(rows: dict[str, dict[str, dict]], variants: list[str]) -> str:
                                "distractors / all of them), pooled over the file's test objects.\n")
 
 
+def per_intent_table(path: str, per: dict[str, dict], variants: list[str]) -> str:
+    """Train-calibrated F1 per intent and variant, next to the surface kernels' recorded F1 in the same file."""
+    res = json.loads(Path(path).read_text(encoding="utf-8"))
+    surface = [k for k in ("language", "vision") if k in res["kernels"]]
+    lines = [f"{Path(path).name}", "", "| intent | " + " | ".join(variants + surface) + " |",
+             "|" + "---|" * (len(variants) + len(surface) + 1)]
+    for iid in per[variants[0]]["intents"]:
+        base = [res["kernels"][k]["intents"][iid]["metrics"]["train-calibrated"]["all"]["f1"] for k in surface]
+        lines.append(f"| {iid} | " + " | ".join(f"{per[v]['intents'][iid]:.2f}" for v in variants) + " | "
+                     + " | ".join(f"{b:.2f}" for b in base) + " |")
+    return "\n".join(lines) + "\n\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="+", help="gift evaluate-alignment --out JSON files with a gift-prob kernel")
@@ -173,11 +188,15 @@ def main(argv: list[str] | None = None) -> int:
                          "(repeatable; 'default' is always included)")
     ap.add_argument("--kernel", help="comma-separated kernel names; the first one in each file is read "
                                      "(default: the file's first gift-prob* kernel)")
+    ap.add_argument("--per-intent", action="store_true",
+                    help="also print each file's train-calibrated F1 per intent, with the surface kernels' F1")
     ap.add_argument("--out", help="also write the table (Markdown) here")
     args = ap.parse_args(argv)
     variants = [parse_variant("default")] + [parse_variant(v) for v in args.variant if v != "default"]
     rows = {p: rescore(p, variants, args.kernel) for p in args.files}
     text = table(rows, [label for label, _ in variants])
+    if args.per_intent:
+        text += "\n" + "".join(per_intent_table(p, per, [label for label, _ in variants]) for p, per in rows.items())
     sys.stdout.write(text)
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")

@@ -37,6 +37,13 @@ def test_the_default_reproduces_the_run_and_the_description_option_changes_it():
     desc = out["embed_text=description"]
     assert not np.array_equal(desc["tc"], out["default"]["tc"]) or desc["auc"] != out["default"]["auc"]
     assert out["default"]["lang"][1] == desc["lang"][1] > 0  # the same named-alike distractors, counted
+    # per intent: the recorded train-calibrated F1 of each intent, and a table with the surface kernels beside it
+    intents = json.loads(RESULT.read_text(encoding="utf-8"))["kernels"]["gift-prob"]["intents"]
+    assert out["default"]["intents"] == pytest.approx(
+        {i: r["metrics"]["train-calibrated"]["all"]["f1"] for i, r in intents.items()})
+    text = mod.per_intent_table(str(RESULT), out, ["default", "embed_text=description"])
+    assert "| intent | default | embed_text=description | language | vision |" in text
+    assert len([ln for ln in text.splitlines() if ln.startswith("| ") and "intent" not in ln]) == len(intents)
 
 
 def test_a_file_not_made_by_this_gift_prob_and_bad_variants_are_refused(tmp_path):
