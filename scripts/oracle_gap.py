@@ -37,7 +37,8 @@ def _counts(predicted: np.ndarray, labels: np.ndarray) -> np.ndarray:
     return np.array([m.tp, m.fp, m.fn])
 
 
-def _f1(c: np.ndarray) -> float:
+def f1(c: np.ndarray) -> float:
+    """F1 from pooled counts ``[tp, fp, fn]`` (0 without a true positive)."""
     return float(2 * c[0] / (2 * c[0] + c[1] + c[2])) if c[0] else 0.0
 
 
@@ -54,19 +55,26 @@ def load_recorded_suite(res: dict, path: str):
     return suite
 
 
+def pick_kernel(res: dict, path: str, kernel: str | None = None) -> str:
+    """The kernel of a result file to read: the first of ``kernel`` (comma-separated names) that the file holds,
+    else (``kernel`` None) its first ``gift-prob*`` kernel; a SystemExit naming the file's kernels otherwise."""
+    prefer = [k for k in (kernel or "").split(",") if k]
+    names = [k for k in prefer if k in res["kernels"]] or \
+        ([] if prefer else [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"])
+    if not names:
+        raise SystemExit(f"{path}: none of the kernels {prefer or ['gift-prob*']} among {sorted(res['kernels'])}")
+    return names[0]
+
+
 def intents_of(path: str, kernel: str | None = None) -> tuple[dict, str, list[tuple[str, np.ndarray, np.ndarray, float]]]:
     """``kernel``: comma-separated kernel names, the first one in the file is read (None: the first gift-prob*).
     The result file, the kernel read, and per intent ``(id, decision [n_test], labels [n_test], cut)`` with the
     recorded train-calibrated cut."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
     suite = load_recorded_suite(res, path)
-    prefer = [k for k in (kernel or "").split(",") if k]
-    names = [k for k in prefer if k in res["kernels"]] or \
-        ([] if prefer else [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"])
-    if not names:
-        raise SystemExit(f"{path}: none of the kernels {prefer or ['gift-prob*']} among {sorted(res['kernels'])}")
+    name = pick_kernel(res, path, kernel)
     rows = []
-    for iid, rec in res["kernels"][names[0]]["intents"].items():
+    for iid, rec in res["kernels"][name]["intents"].items():
         labels = {t.object: bool(t.relevant) for t in suite.intent(iid).test}
         scores = rec["scores"]
         decision = np.asarray(scores["decision"], dtype=float)
@@ -75,7 +83,7 @@ def intents_of(path: str, kernel: str | None = None) -> tuple[dict, str, list[tu
             raise SystemExit(f"{path}: intent {iid!r}: test objects {missing} have no label in suite {res['suite']!r}")
         y = np.array([labels[t] for t in scores["test"]], dtype=bool)
         rows.append((iid, decision, y, float(rec["thresholds"]["train-calibrated"]["cut"])))
-    return res, names[0], rows
+    return res, name, rows
 
 
 def gap(rows: Sequence[tuple[str, np.ndarray, np.ndarray, float]], splits: int = 300, seed: int = 0) -> dict:
@@ -96,9 +104,9 @@ def gap(rows: Sequence[tuple[str, np.ndarray, np.ndarray, float]], splits: int =
             h_tc += _counts(d[b] >= cut, y[b])
             h_lab += _counts(d[b] >= middle_f1_cut(d[a], y[a]), y[b])
             h_or += _counts(d[b] >= oracle_cut(d[b], y[b]), y[b])
-        halves[r] = (_f1(h_tc), _f1(h_lab), _f1(h_or))
+        halves[r] = (f1(h_tc), f1(h_lab), f1(h_or))
     mean = halves.mean(axis=0)
-    return {"train_calibrated": _f1(tc), "leave_one_out": _f1(loo), "oracle": _f1(orc),
+    return {"train_calibrated": f1(tc), "leave_one_out": f1(loo), "oracle": f1(orc),
             "half_train_calibrated": float(mean[0]), "half_labelled": float(mean[1]), "half_oracle": float(mean[2]),
             "intents": len(rows), "test_objects": int(sum(d.size for _, d, _, _ in rows))}
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from oracle_gap import load_recorded_suite  # noqa: E402  (this directory's script: the suite check)
+from oracle_gap import f1, load_recorded_suite, pick_kernel  # noqa: E402  (this directory's script)
 
 from gift.core.alignment import AlignmentScores, oracle_cut  # noqa: E402
 from gift.core.metrics import binary_metrics, roc_auc  # noqa: E402
@@ -47,16 +47,6 @@ def parse_variant(text: str) -> tuple[str, dict]:
                              f"(options that act after the LM), got {part!r}")
         out[key] = AFTER_LM[key](value)
     return text, out
-
-
-def kernel_records(res: dict, path: str, kernel: str | None = None) -> tuple[str, dict]:
-    """The first of ``kernel`` (comma-separated names) found in the file, else its first gift-prob* kernel."""
-    prefer = [k for k in (kernel or "").split(",") if k]
-    names = [k for k in prefer if k in res["kernels"]] or \
-        ([] if prefer else [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"])
-    if not names:
-        raise SystemExit(f"{path}: none of the kernels {prefer or ['gift-prob*']} among {sorted(res['kernels'])}")
-    return names[0], res["kernels"][names[0]]["intents"]
 
 
 def base_options(kernel_name: str) -> dict:
@@ -93,7 +83,8 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
     the other variants are applied on top of it."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
     suite = load_recorded_suite(res, path)
-    kname, intents = kernel_records(res, path, kernel)
+    kname = pick_kernel(res, path, kernel)
+    intents = res["kernels"][kname]["intents"]
     scenes = []
     for iid, rec in intents.items():
         sc, det = rec["scores"], rec["details"]
@@ -111,10 +102,10 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
     base, worst = None, []
     for guess in RUN_DEFAULTS:
         opts = {**guess, **base_options(kname)}
-        dev = max((float(np.abs(_relevance(opts, lo, t, tr, rel)[: len(t)] - d).max(initial=0.0)), iid)
-                  for iid, _, t, tr, rel, _, _, lo, d in scenes)
+        rels = [_relevance(opts, lo, t, tr, rel) for _, _, t, tr, rel, _, _, lo, _ in scenes]
+        dev = max((float(np.abs(p[: len(sc[2])] - sc[8]).max(initial=0.0)), sc[0]) for p, sc in zip(rels, scenes))
         if dev[0] <= 1e-5:
-            base = opts
+            base, base_rel = opts, dict(zip((sc[0] for sc in scenes), rels))
             break
         worst.append(dev)
     if base is None:
@@ -125,7 +116,7 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
                    "intents": {}} for label, o in variants}
     for iid, scores, test, train, rel, y, named, lo, _ in scenes:
         for label, opts in variants:
-            p = _relevance({**base, **opts}, lo, test, train, rel)
+            p = base_rel[iid] if not opts else _relevance({**base, **opts}, lo, test, train, rel)
             view = scores.with_relevance(p[: len(test)], p[len(test):])
             pred = view.predicted_relevant(view.threshold("train-calibrated")[0])
             o = out[label]
@@ -139,10 +130,6 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
             o["lang"][0] += int((pred & named).sum())
             o["lang"][1] += int(named.sum())
     return out
-
-
-def f1(c: np.ndarray) -> float:
-    return float(2 * c[0] / (2 * c[0] + c[1] + c[2])) if c[0] else 0.0
 
 
 def table(rows: dict[str, dict[str, dict]], variants: list[str]) -> str:
@@ -180,6 +167,23 @@ def per_intent_table(path: str, per: dict[str, dict], variants: list[str]) -> st
     return "\n".join(lines) + "\n\n"
 
 
+def provenance(paths: list[str]) -> str:
+    """What made the table: this checkout's commit, and per file the run's commit, suite and model file hashes."""
+    from gift.core.provenance import git_commit
+
+    here = git_commit() or {}
+    lines = [f"Re-scored by `scripts/recombine_terms.py` at commit `{str(here.get('commit', '?'))[:7]}`"
+             f"{' (dirty)' if here.get('dirty') else ''}; each file's run:", ""]
+    for path in paths:
+        m = json.loads(Path(path).read_text(encoding="utf-8")).get("manifest", {})
+        git, lm = m.get("git") or {}, m.get("lm") or {}
+        lines.append(f"- {Path(path).name}: commit `{str(git.get('commit', '?'))[:7]}`"
+                     f"{' (dirty)' if git.get('dirty') else ''}, suite sha256 "
+                     f"`{str((m.get('suite') or {}).get('sha256', '?'))[:12]}`, LM `{lm.get('identity', '?')}` "
+                     f"(model sha256 `{str(lm.get('model_sha256', '?'))[:12]}`)")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="+", help="gift evaluate-alignment --out JSON files with a gift-prob kernel")
@@ -197,6 +201,7 @@ def main(argv: list[str] | None = None) -> int:
     text = table(rows, [label for label, _ in variants])
     if args.per_intent:
         text += "\n" + "".join(per_intent_table(p, per, [label for label, _ in variants]) for p, per in rows.items())
+    text += "\n" + provenance(args.files)
     sys.stdout.write(text)
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")

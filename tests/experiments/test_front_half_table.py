@@ -2,18 +2,13 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "front_half_table.py"
+import script_module  # this directory: scripts/ files as modules
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("front_half_table_script", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module.load_script("front_half_table")
 
 
 def result(suite: str, counts: dict[str, tuple[int, int, int]], n_intents: int, commit: str) -> dict:

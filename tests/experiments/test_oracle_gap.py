@@ -2,22 +2,18 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import pytest
+import script_module  # this directory: scripts/ files as modules
 
 ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "scripts" / "oracle_gap.py"
 RESULT = ROOT / "docs" / "results" / "data" / "front_half" / "gift-dev5-inferred.json"
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("oracle_gap_script", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module.load_script("oracle_gap")
 
 
 def test_gap_reproduces_the_recorded_f1_and_orders_the_labelled_cuts():

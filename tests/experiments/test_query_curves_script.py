@@ -3,20 +3,15 @@ commit and code version (the page's provenance line names each part)."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
-
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "query_curves.py"
+import script_module  # this directory: scripts/ files as modules
 
 
 @pytest.fixture(scope="module")
 def script():
-    spec = importlib.util.spec_from_file_location("query_curves_script", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module.load_script("query_curves")
 
 
 def _run(commit: str, version: str, suite: str, seconds: float) -> dict:

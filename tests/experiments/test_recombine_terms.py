@@ -3,25 +3,21 @@ gift-prob decisions and F1 (real MiniLM), an after-LM option changes them, bad i
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+import script_module  # this directory: scripts/ files as modules
 
 ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "scripts" / "recombine_terms.py"
 RESULT = ROOT / "docs" / "results" / "data" / "front_half" / "gift-dev5-inferred.json"
 
 pytestmark = pytest.mark.slow  # MiniLM
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("recombine_terms_script", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module.load_script("recombine_terms")
 
 
 def test_the_default_reproduces_the_run_and_the_description_option_changes_it():
@@ -44,6 +40,11 @@ def test_the_default_reproduces_the_run_and_the_description_option_changes_it():
     text = mod.per_intent_table(str(RESULT), out, ["default", "embed_text=description"])
     assert "| intent | default | embed_text=description | language | vision |" in text
     assert len([ln for ln in text.splitlines() if ln.startswith("| ") and "intent" not in ln]) == len(intents)
+    # what made the numbers: the run's commit, suite and model hashes, as recorded in the file
+    manifest = json.loads(RESULT.read_text(encoding="utf-8"))["manifest"]
+    note = mod.provenance([str(RESULT)])
+    assert f"commit `{manifest['git']['commit'][:7]}`" in note and manifest["suite"]["sha256"][:12] in note
+    assert manifest["lm"]["model_sha256"][:12] in note
 
 
 def test_a_file_not_made_by_this_gift_prob_and_bad_variants_are_refused(tmp_path):
