@@ -302,11 +302,13 @@ def score_intent(kernel: Any, suite: Suite, spec: IntentSpec, intent: Intent | N
 
 
 def alignment_record(scores: AlignmentScores, cuts: Mapping[str, tuple[float, str]], metrics: Mapping,
-                     seconds: float) -> dict[str, Any]:
+                     seconds: float, kernel: Any = None) -> dict[str, Any]:
     """The JSON record of one kernel on one intent: per threshold the cut, its note, the mapping and
     metrics; per object its decision score and matched training object; fallbacks and kernel details;
-    ``scores`` (:meth:`AlignmentScores.to_dict`, to re-threshold or ask queries without the kernel)."""
-    out: dict[str, Any] = {"thresholds": {}, "seconds": round(seconds, 3), "fallbacks": list(scores.fallbacks),
+    ``scores`` (:meth:`AlignmentScores.to_dict`, to re-threshold or ask queries without the kernel);
+    ``configuration``: ``repr(kernel)``, every option the kernel ran with, defaults included."""
+    out: dict[str, Any] = {"configuration": None if kernel is None else repr(kernel),
+                           "thresholds": {}, "seconds": round(seconds, 3), "fallbacks": list(scores.fallbacks),
                            "details": dict(scores.details), "relevant_train": list(scores.relevant_train),
                            "objects": {name: {"decision": float(scores.decision[i]),
                                               "match": scores.train[scores.target[i]] if scores.train else None}
@@ -339,7 +341,7 @@ def align_stage(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSp
         t0 = time.perf_counter()
         kernel = comp.kernel(kernel_spec)
         scores, cuts, metrics = score_intent(kernel, suite, spec, intent, relevant.names, thresholds)
-        return alignment_record(scores, cuts, metrics, time.perf_counter() - t0)
+        return alignment_record(scores, cuts, metrics, time.perf_counter() - t0, kernel)
 
     return cache.get_or_compute(spec.id, f"align-{kernel_spec}", inputs, compute)
 

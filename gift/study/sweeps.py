@@ -359,7 +359,7 @@ def align_item(item: AlignItem, *, echo: bool = False) -> ItemOutcome:
                               line=_failed_line(item.kernel, spec.id, failure.message))
         else:
             seconds = time.perf_counter() - t0
-            record = alignment_record(scores, cuts, metrics, seconds)
+            record = alignment_record(scores, cuts, metrics, seconds, kernel)
             record.update({"intent": spec.id, "intent_text": intent.text, "relevant": relevant.to_dict()})
             if queried is not None:
                 record["queries"] = queried
@@ -428,8 +428,9 @@ class _Table:
             self.checkpoint(self.out)
 
     def _partial(self, kernel: str) -> dict:
-        out = {"kernel": kernel, "errors": dict(self.errors), "overall": _pooled(self.suite, self.records,
-                                                                                 self.thresholds),
+        configs = list(dict.fromkeys(r.get("configuration") for r in self.records))
+        out = {"kernel": kernel, "configuration": configs[0] if len(configs) == 1 else configs,
+               "errors": dict(self.errors), "overall": _pooled(self.suite, self.records, self.thresholds),
                "intents": {r["intent"]: _intent_entry(r) for r in self.records}}
         if any("queries" in r for r in self.records):
             out["queries"] = _pooled_queries(self.suite, self.records)

@@ -300,3 +300,15 @@ def test_query_curves_from_gift_report(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text('{"x": 1}')
     assert main(["report", str(tmp_path), "--no-render", "--query-curves", str(bad)]) != 0
+
+
+def test_the_kernels_as_built_are_in_the_run_section(tmp_path):
+    """A result whose alignment records carry ``configuration`` (``repr`` of the kernel as built) shows them;
+    the committed Franka run predates the record and shows none."""
+    results = json.loads(FRANKA.read_text())
+    page = write_html_report(results, tmp_path / "old", render=False).read_text()
+    assert "kernels as built" not in page
+    for rec in results["alignment"]["valuables"].values():
+        rec["configuration"] = "LanguageKernel(use_descriptions=False, names=True)"
+    page = write_html_report(results, tmp_path / "new", render=False).read_text()
+    assert "kernels as built" in page and "LanguageKernel(use_descriptions=False, names=True)" in page

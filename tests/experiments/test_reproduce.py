@@ -84,6 +84,11 @@ def test_report_figures_and_results_json(reduced):
     text = report.read_text()
     for k in KERNELS:
         assert f"| {k} " in text or f" {k} |" in text
+    # every kernel as it was built, its defaults included, in results.json and the report
+    built = {k: results["alignment"]["valuables"][k]["configuration"] for k in KERNELS}
+    assert built["gift"].startswith("MappingKernel(samples=1,") and "use_intent=True" in built["gift"]
+    assert "use_intent=False" in built["lm-no-intent"] and "embed_text='description'" in built["gift-prob"]
+    assert f"- `gift-prob`: `{built['gift-prob']}`" in text
     pngs = {p.name for p in out.glob("*.png")}
     assert {"win_rate.png", "intent_cosine.png", "f1_train-calibrated.png", "confounds_train-calibrated.png",
             "scatter_valuables.png", "boltzmann_valuables.png"} <= pngs

@@ -39,6 +39,9 @@ def test_evaluation_reports_every_subset_threshold_and_intent_and_keeps_going_af
             f1 = {t: r["metrics"][t]["all"]["f1"] for t in res["thresholds"]}
             assert f1["oracle"] >= max(f1["non-oracle"], f1["train-calibrated"]) - 1e-12
             assert 0.0 <= r["metrics"]["oracle"]["all"]["auc"] <= 1.0
+    # each kernel records every option it ran with, defaults included, as built from its spec
+    assert res["kernels"]["language"]["configuration"] == "LanguageKernel(use_descriptions=False, names=True)"
+    assert "use_descriptions=True" in res["kernels"]["language:use_descriptions=true"]["configuration"]
     # the language confound of the paper: toothbrush matches paintbrush by name
     obj = res["kernels"]["language"]["intents"]["art_supplies"]["objects"]
     assert obj["toothbrush"]["match"] == "paintbrush"

@@ -39,7 +39,7 @@ import numpy as np
 
 from gift.core.data import DISTRACTOR
 from gift_experiments.lm_calls import LM_CALLS, LMCall, read_calls
-from gift_experiments.report import KERNEL_ORDER, SUBSET_LABEL
+from gift_experiments.report import KERNEL_ORDER, SUBSET_LABEL, kernel_configurations
 from gift_experiments.svg_plots import Line, Point, StripRow, bar_chart, esc, lines, scatter, strips
 from gift_experiments.views import load_alignments, main_threshold, relevant_training
 
@@ -206,6 +206,10 @@ class Report:
                 rows.append((k, esc(self.cfg[k])))
         if self.cfg.get("kernels"):
             rows.append(("kernels", esc(", ".join(self.cfg["kernels"]))))
+        built = kernel_configurations(self.r)
+        if built:
+            rows.append(("kernels as built", "<br>".join(f"<code>{esc(k)}</code>: <code>{esc(v)}</code>"
+                                                        for k, v in built.items())))
         if self.threshold:
             rows.append(("threshold shown", esc(self.threshold)))
         lm = m.get("lm") or {}

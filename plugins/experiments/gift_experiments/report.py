@@ -425,10 +425,29 @@ def write_report(results: dict, out: Path, command: str = "") -> Path:
             lines.append(f"| {r.get('started', '')} | {r.get('seconds', '')} | {commit or '–'} | "
                          f"{lm.get('identity', '–')} | {(lm.get('model_sha256') or '–')[:12]} |")
         lines.append("")
+    built = kernel_configurations(results)
+    if built:
+        lines += ["## Kernels as built", "", "Every option each kernel ran with, defaults included:", ""]
+        lines += [f"- `{k}`: `{v}`" for k, v in built.items()] + [""]
     lines += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures] + [""]
     path = out / "report.md"
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def kernel_configurations(results: Mapping[str, Any]) -> dict[str, str]:
+    """``{kernel spec: repr of the kernel as built}`` from a ``gift reproduce`` result (``alignment``) or an
+    ``evaluate-alignment`` result (``kernels``); runs older than the record have none."""
+    out: dict[str, str] = {}
+    for per_kernel in (results.get("alignment") or {}).values():
+        for spec, rec in per_kernel.items():
+            if isinstance(rec, Mapping) and rec.get("configuration"):
+                out.setdefault(spec, rec["configuration"])
+    for spec, rec in (results.get("kernels") or {}).items():
+        conf = rec.get("configuration") if isinstance(rec, Mapping) else None
+        if conf:
+            out.setdefault(spec, conf if isinstance(conf, str) else " | ".join(map(str, conf)))
+    return out
 
 
 # ----------------------------------------------------------------------------- text report

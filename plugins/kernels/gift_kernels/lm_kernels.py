@@ -147,6 +147,10 @@ class MappingKernel(SimilarityKernel):
         self.fallbacks: list[str] = []  # samples completed by default (see _sample)
         self.stats = AskStats()  # answers read, repair requests, samples still invalid after the repairs
 
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}(samples={self.samples}, temperature={self.temperature}, seed={self.seed}, "
+                f"use_intent={self.use_intent}, max_repairs={self.max_repairs}, constrained={self.constrained})")
+
     @property
     def lm(self) -> LMBackend:
         if self._lm is None:
