@@ -34,6 +34,7 @@ from gift_kernels.lm_kernels import _sigmoid, _zscore, separation_weight
 import gift
 from gift.core.alignment import best_separating_cut
 from gift.core.metrics import binary_metrics
+from gift.study.sweeps import recorded_suite
 
 DATA = Path(__file__).resolve().parents[1] / "docs" / "results" / "data" / "front_half"
 FILES = ("gift-dev-inferred", "lm-dev-inferred", "gift-dev-ground-truth", "lm-dev-ground-truth",
@@ -60,7 +61,7 @@ def rescore(lo: np.ndarray, sim: np.ndarray, pos: list[int], neg: list[int], evi
 
 def pooled_f1(path: Path, k: int, mode: str, language) -> float:
     res = json.loads(path.read_text())
-    suite = gift.load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, str(path))
     preds, truth = [], []
     for iid, rec in res["kernels"]["gift-prob"]["intents"].items():
         spec, sc, terms = suite.intent(iid), rec["scores"], rec["details"]["terms"]

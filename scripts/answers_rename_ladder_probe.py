@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-import gift
 from gift.core.data import Intent
 from gift.core.metrics import roc_auc
+from gift.study.sweeps import recorded_suite
 
 log = logging.getLogger("answers_rename_ladder_probe")
 
@@ -35,7 +35,7 @@ def zscore(v: np.ndarray) -> np.ndarray:
 
 def probe(path: str, kernel, questions: int = 2) -> list[dict]:
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = gift.load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, str(path))
     rows = []
     for intent_id, rec in res["kernels"]["gift-prob"]["intents"].items():
         ladder = rec["details"].get("ladder")

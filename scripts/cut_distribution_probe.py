@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from gift.core.metrics import binary_metrics
-from gift.core.suite import load_suite
+from gift.study.sweeps import recorded_suite
 
 log = logging.getLogger("cut_distribution_probe")
 
@@ -49,7 +49,7 @@ RULES: dict[str, Callable[[np.ndarray, np.ndarray], float] | None] = {
 def probe(path: str) -> dict[str, float]:
     """Pooled F1 of the run's gift-prob kernel under each rule of :data:`RULES`."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, str(path))
     by_id = {s.id: s for s in suite.intents}
     names = [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"]
     if len(names) != 1:

@@ -20,16 +20,16 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-
-import gift
 from gift_kernels.calibration import TermCalibration
+
+from gift.study.sweeps import recorded_suite
 
 
 def collect(paths: Sequence[str], kernel_prefix: str = "gift-prob") -> tuple[np.ndarray, np.ndarray, dict]:
     X, y, seen = [], [], {"suites": {}, "kernels": set()}
     for path in paths:
         res = json.loads(Path(path).read_text(encoding="utf-8"))
-        suite = gift.load_suite(res["suite_path"] or res["suite"])
+        suite = recorded_suite(res, str(path))
         for kname, k in res["kernels"].items():
             if not kname.startswith(kernel_prefix):
                 continue

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-import gift
+from gift.study.sweeps import recorded_suite
 
 TC, OR = "train-calibrated", "oracle"
 
@@ -28,7 +28,7 @@ TC, OR = "train-calibrated", "oracle"
 def table(path: str, extra: Sequence[str] = ()) -> str:
     """``extra``: results of the same suite and intent source whose other kernels join the table."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = gift.load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, str(path))
     kernels = dict(res["kernels"])
     for e in extra:
         more = json.loads(Path(e).read_text(encoding="utf-8"))

@@ -33,9 +33,9 @@ from typing import Any
 
 import numpy as np
 
-import gift
 from gift.core.alignment import best_separating_cut, oracle_cut
 from gift.core.metrics import binary_metrics, roc_auc
+from gift.study.sweeps import recorded_suite
 
 KERNEL_PREFIX = "gift-prob"
 
@@ -50,7 +50,7 @@ def load_rows(paths: Sequence[str]) -> list[dict[str, Any]]:
     rows = []
     for path in paths:
         res = json.loads(Path(path).read_text())
-        suite = gift.load_suite(res["suite_path"] or res["suite"])
+        suite = recorded_suite(res, str(path))
         kname = next((k for k in res["kernels"] if k.startswith(KERNEL_PREFIX)), None)
         if kname is None:
             continue

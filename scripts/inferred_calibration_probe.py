@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-import gift
 from gift.core.metrics import binary_metrics
+from gift.study.sweeps import recorded_suite
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from gift_prob_study import fit_logistic
@@ -34,7 +34,7 @@ RUNS = ("gift-dev-inferred", "gift-dev-ground-truth", "lm-dev-inferred", "lm-dev
 def load(name: str) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
     """Per intent: test features ``[n, 2]``, training features ``[m, 2]``, test labels, relevant training mask."""
     res = json.loads((DATA / f"{name}.json").read_text())
-    suite = gift.load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, f"{name}.json")
     out = []
     for iid, rec in res["kernels"]["gift-prob"]["intents"].items():
         t = rec["details"]["terms"]

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from gift.core.metrics import roc_auc
-from gift.core.suite import load_suite
+from gift.study.sweeps import recorded_suite
 
 log = logging.getLogger("ladder_rung_weights_probe")
 
@@ -31,7 +31,7 @@ def zscore(v: np.ndarray) -> np.ndarray:
 def probe(path: str) -> dict[str, float]:
     """Mean over the run's intents of each rule's LM-only test AUC."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = load_suite(res["suite_path"] or res["suite"])
+    suite = recorded_suite(res, str(path))
     out: dict[str, list[float]] = {"goal": [], "mean": [], "weighted": [], "kept": []}
     names = [k for k in res["kernels"] if k.split(":")[0] == "gift-prob"]
     if len(names) != 1:

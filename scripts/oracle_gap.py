@@ -19,7 +19,6 @@ Offline, from the scores saved in the files; no LM or simulator runs.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import sys
 from collections.abc import Sequence
@@ -27,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-import gift
 from gift.core.alignment import leave_one_out_oracle, middle_f1_cut, oracle_cut
 from gift.core.metrics import binary_metrics
+from gift.study.sweeps import recorded_suite
 
 
 def _counts(predicted: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -40,19 +39,6 @@ def _counts(predicted: np.ndarray, labels: np.ndarray) -> np.ndarray:
 def f1(c: np.ndarray) -> float:
     """F1 from pooled counts ``[tp, fp, fn]`` (0 without a true positive)."""
     return float(2 * c[0] / (2 * c[0] + c[1] + c[2])) if c[0] else 0.0
-
-
-def load_recorded_suite(res: dict, path: str):
-    """The suite a result file was made on: its recorded path when it exists here, else its name; the file's
-    bytes must hash to the recorded sha256 (the labels read are those the run was scored against)."""
-    rec = res.get("manifest", {}).get("suite") or {}
-    where = res.get("suite_path")
-    suite = gift.load_suite(where if where and Path(where).exists() else res["suite"])
-    digest = hashlib.sha256(Path(suite.path).read_bytes()).hexdigest()
-    if rec.get("sha256") and rec["sha256"] != digest:
-        raise SystemExit(f"{path}: suite {res['suite']!r} has changed since the run (sha256 {digest[:12]} here, "
-                         f"{rec['sha256'][:12]} recorded): its labels may not be the ones the run was scored on")
-    return suite
 
 
 def pick_kernel(res: dict, path: str, kernel: str | None = None) -> str:
@@ -71,7 +57,7 @@ def intents_of(path: str, kernel: str | None = None) -> tuple[dict, str, list[tu
     The result file, the kernel read, and per intent ``(id, decision [n_test], labels [n_test], cut)`` with the
     recorded train-calibrated cut."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = load_recorded_suite(res, path)
+    suite = recorded_suite(res, path)
     name = pick_kernel(res, path, kernel)
     rows = []
     for iid, rec in res["kernels"][name]["intents"].items():

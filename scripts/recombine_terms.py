@@ -26,10 +26,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from oracle_gap import f1, load_recorded_suite, pick_kernel  # noqa: E402  (this directory's script)
+from oracle_gap import f1, pick_kernel  # noqa: E402  (this directory's script)
 
 from gift.core.alignment import AlignmentScores, oracle_cut  # noqa: E402
 from gift.core.metrics import binary_metrics, roc_auc  # noqa: E402
+from gift.study.sweeps import recorded_suite  # noqa: E402
 
 AFTER_LM = {"embed_text": str, "weight": float, "weighting": str, "embed_reference": str, "standardize": str,
             "combine": str}
@@ -82,7 +83,7 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
     :data:`RUN_DEFAULTS` (over the options in the kernel's name) that reproduces every saved decision to 1e-5;
     the other variants are applied on top of it."""
     res = json.loads(Path(path).read_text(encoding="utf-8"))
-    suite = load_recorded_suite(res, path)
+    suite = recorded_suite(res, path)
     kname = pick_kernel(res, path, kernel)
     intents = res["kernels"][kname]["intents"]
     scenes = []

@@ -43,16 +43,16 @@ from gift.study.chain import (
     RelevantTraining,
     StudyConfig,
     add_usage,
+    alignment_record,
     get_training,
     intent_seeds,
     intent_stage,
-    relevant_training,
-    run_intent,
-    score_intent,
-    alignment_record,
     query_stage,
     query_threshold,
+    relevant_training,
     rescorer,
+    run_intent,
+    score_intent,
     subset_masks,
 )
 from gift.study.components import check_spec, components_for
@@ -83,6 +83,35 @@ def suite_provenance(suite: Suite) -> dict[str, Any]:
     if suite.path and Path(suite.path).is_file():
         out["sha256"] = file_sha256(suite.path)
     return out
+
+
+def recorded_suite(result: Mapping[str, Any], where: str = "result") -> Suite:
+    """The suite a result (of ``evaluate-alignment`` or ``reproduce``) was scored on: the first of its recorded
+    file (when that exists here) and the suite of its name whose bytes hash to the sha256 the result's manifest
+    recorded (without a recorded hash, the first). A GiftError naming ``where`` when none does: the labels read
+    would not be the ones the run was scored on."""
+    rec = (result.get("manifest") or {}).get("suite") or {}
+    paths = [result.get("suite_path"), rec.get("path"), (result.get("config") or {}).get("suite")]
+    candidates = list(dict.fromkeys(p for p in paths if p and Path(p).is_file()))
+    name = result.get("suite") or rec.get("name")
+    if name:
+        candidates.append(name)
+    if not candidates:
+        raise GiftError(f"{where}: records no suite (no suite_path, manifest suite or config suite)")
+    seen = []
+    for c in candidates:
+        try:
+            suite = load_suite(c)
+        except GiftError as e:
+            seen.append(f"{c}: {e}")
+            continue
+        digest = file_sha256(suite.path) if suite.path else None
+        if not rec.get("sha256") or rec["sha256"] == digest:
+            return suite
+        seen.append(f"{suite.path}: sha256 {str(digest)[:12]}")
+    raise GiftError(f"{where}: suite {name!r} has changed since the run (recorded sha256 "
+                    f"{str(rec.get('sha256'))[:12]}; here {'; '.join(seen)}): its labels may not be the ones the run "
+                    "was scored on")
 
 
 def versions() -> dict[str, str]:
