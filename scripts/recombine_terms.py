@@ -14,6 +14,9 @@ applied on top of it.
 
     python scripts/recombine_terms.py docs/results/data/front_half/gift-dev6-inferred.json \
         --variant embed_text=description --variant weight=0.25 --out table.md
+
+``--queries 0,1,2,4`` adds F1 after that many questions per intent (``--policy``, default ``uncertainty``),
+answered from the suite's labels on the re-scored scenes (issue 20's measurement, without the LM).
 """
 
 from __future__ import annotations
@@ -114,13 +117,14 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
                          f"difference {min(worst)[0]:.2e}, intent {min(worst)[1]!r}); this file was not made by "
                          f"this code's gift-prob")
     out = {label: {"tc": np.zeros(3), "oracle": np.zeros(3), "auc": [], "lang": [0, 0], "options": {**base, **o},
-                   "intents": {}} for label, o in variants}
+                   "intents": {}, "views": {}} for label, o in variants}
     for iid, scores, test, train, rel, y, named, lo, _ in scenes:
         for label, opts in variants:
             p = base_rel[iid] if not opts else _relevance({**base, **opts}, lo, test, train, rel)
             view = scores.with_relevance(p[: len(test)], p[len(test):])
             pred = view.predicted_relevant(view.threshold("train-calibrated")[0])
             o = out[label]
+            o["views"][iid] = (view, dict(zip(view.test, y.tolist())))
             for key, predicted in (("tc", pred), ("oracle", p[: len(test)] >= oracle_cut(p[: len(test)], y))):
                 m = binary_metrics(predicted, y)
                 o[key] += (m.tp, m.fp, m.fn)
@@ -131,6 +135,37 @@ def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = No
             o["lang"][0] += int((pred & named).sum())
             o["lang"][1] += int(named.sum())
     return out
+
+
+def after_queries(per: dict[str, dict], variant: str, ks: list[int], policy: str = "uncertainty") -> np.ndarray:
+    """Pooled counts ``[len(ks), 3]`` (tp, fp, fn) after ``k`` questions per intent chosen by ``policy`` and
+    answered from the suite's labels (``gift.core.queries``, its default rules: answers fix the objects they are
+    about, the cut stays), on the re-scored scenes of one variant. ``random`` uses seed 0 only."""
+    from gift.core.queries import QueryProblem, ask, labels_answerer
+
+    counts = np.zeros((len(ks), 3))
+    for view, labels in per[variant]["views"].values():
+        y = np.array([labels[t] for t in view.test], dtype=bool)
+        for i, k in enumerate(ks):
+            state = ask(QueryProblem.of(view, "train-calibrated"), policy, labels_answerer(labels), k, seed=0)
+            m = binary_metrics(np.asarray(state.predicted, dtype=bool), y)
+            counts[i] += (m.tp, m.fp, m.fn)
+    return counts
+
+
+def queries_table(rows: dict[str, dict[str, dict]], variants: list[str], ks: list[int], policy: str) -> str:
+    """Train-calibrated F1 after k questions per intent, per file and variant, and pooled over the files."""
+    lines = ["| file | variant | " + " | ".join(f"{k} q" for k in ks) + " |", "|" + "---|" * (len(ks) + 2)]
+    pooled = {v: np.zeros((len(ks), 3)) for v in variants}
+    for path, per in rows.items():
+        for v in variants:
+            c = after_queries(per, v, ks, policy)
+            pooled[v] += c
+            lines.append(f"| {Path(path).name} | {v} | " + " | ".join(f"{f1(r):.3f}" for r in c) + " |")
+    if len(rows) > 1:
+        lines += [f"| **pooled** | {v} | " + " | ".join(f"{f1(r):.3f}" for r in pooled[v]) + " |" for v in variants]
+    return "\n".join(lines) + (f"\n\nF1 with the train-calibrated cut after k `{policy}` questions per intent, "
+                               "answered from the suite's labels (answers fix their objects; the cut stays).\n")
 
 
 def table(rows: dict[str, dict[str, dict]], variants: list[str]) -> str:
@@ -195,13 +230,26 @@ def main(argv: list[str] | None = None) -> int:
                                      "(default: the file's first gift-prob* kernel)")
     ap.add_argument("--per-intent", action="store_true",
                     help="also print each file's train-calibrated F1 per intent, with the surface kernels' F1")
+    ap.add_argument("--queries", help="comma-separated numbers of questions per intent, e.g. 0,1,2,4: also print "
+                                      "F1 after that many questions, per variant (offline, from the saved scores)")
+    ap.add_argument("--policy", default="uncertainty", help="query policy of --queries (default: uncertainty)")
     ap.add_argument("--out", help="also write the table (Markdown) here")
     args = ap.parse_args(argv)
+    ks: list[int] = []
+    if args.queries:
+        try:
+            ks = [int(k) for k in args.queries.split(",") if k.strip()]
+        except ValueError:
+            raise SystemExit(f"--queries: comma-separated whole numbers, got {args.queries!r}") from None
+        if not ks or min(ks) < 0:
+            raise SystemExit(f"--queries: comma-separated whole numbers >= 0, got {args.queries!r}")
     variants = [parse_variant("default")] + [parse_variant(v) for v in args.variant if v != "default"]
     rows = {p: rescore(p, variants, args.kernel) for p in args.files}
     text = table(rows, [label for label, _ in variants])
     if args.per_intent:
         text += "\n" + "".join(per_intent_table(p, per, [label for label, _ in variants]) for p, per in rows.items())
+    if args.queries:
+        text += "\n" + queries_table(rows, [label for label, _ in variants], ks, args.policy)
     text += "\n" + provenance(args.files)
     sys.stdout.write(text)
     if args.out:

@@ -47,6 +47,24 @@ def test_the_default_reproduces_the_run_and_the_description_option_changes_it():
     assert manifest["lm"]["model_sha256"][:12] in note
 
 
+def test_questions_on_the_rescored_scenes_match_the_query_curves_of_the_same_run():
+    """``--queries``: on the run's own options, F1 after k `uncertainty` questions is the one the committed query
+    curves measured for this suite (`scripts/query_curves.py`, real chain); answers only fix their objects, so
+    F1 never falls with more questions."""
+    mod = load_script()
+    variants = [mod.parse_variant("default"), mod.parse_variant("embed_text=description")]
+    out = mod.rescore(str(RESULT), variants)
+    curves = json.loads((ROOT / "docs" / "results" / "queries" / "curves.json").read_text(encoding="utf-8"))
+    run = curves["runs"]["gift-dev5 | inferred"]
+    counts = mod.after_queries(out, "default", run["grid"], "uncertainty")
+    assert [mod.f1(c) for c in counts] == pytest.approx(run["curves"]["uncertainty"]["f1"])
+    assert np.array_equal(counts[0], out["default"]["tc"])
+    desc = [mod.f1(c) for c in mod.after_queries(out, "embed_text=description", [0, 1, 2, 4], "uncertainty")]
+    assert desc == sorted(desc) and desc[0] == pytest.approx(mod.f1(out["embed_text=description"]["tc"]))
+    text = mod.queries_table({str(RESULT): out}, ["default"], [0, 2], "uncertainty")
+    assert "| gift-dev5-inferred.json | default | 0.841 | 0.920 |" in text
+
+
 def test_a_file_not_made_by_this_gift_prob_and_bad_variants_are_refused(tmp_path):
     mod = load_script()
     res = json.loads(RESULT.read_text(encoding="utf-8"))
@@ -60,3 +78,7 @@ def test_a_file_not_made_by_this_gift_prob_and_bad_variants_are_refused(tmp_path
         mod.parse_variant("template=kind")
     with pytest.raises(SystemExit, match="none of the kernels"):
         mod.rescore(str(RESULT), [mod.parse_variant("default")], kernel="gift")
+    with pytest.raises(SystemExit, match="--queries: comma-separated whole numbers"):
+        mod.main([str(RESULT), "--queries", "0,two"])
+    with pytest.raises(SystemExit, match="--queries: comma-separated whole numbers >= 0"):
+        mod.main([str(RESULT), "--queries", "-1"])
