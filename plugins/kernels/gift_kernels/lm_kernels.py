@@ -393,6 +393,7 @@ class GiftProbKernel(RelevanceKernel):
         #: log-odds on another scale); docs/results/front_half.md.
         if calibration != "none" and combine != "language":
             raise GiftError("gift-prob: calibration needs both terms (combine='language')")
+        self.calibration_spec = calibration
         if calibration == "none":
             self.calibration = None
         else:
@@ -421,7 +422,10 @@ class GiftProbKernel(RelevanceKernel):
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
-                f"embed_text={self.embed_text!r})")
+                f"embed_text={self.embed_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
+                f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
+                f"calibration={self.calibration_spec!r}, "
+                f"language_kernel={'default' if self._language is None else repr(self._language)})")
 
     # ------------------------------------------------------------------ pieces
     @property
