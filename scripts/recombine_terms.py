@@ -141,14 +141,16 @@ def after_queries(per: dict[str, dict], variant: str, ks: list[int], policy: str
     """Pooled counts ``[len(ks), 3]`` (tp, fp, fn) after ``k`` questions per intent chosen by ``policy`` and
     answered from the suite's labels (``gift.core.queries``, its default rules: answers fix the objects they are
     about, the cut stays), on the re-scored scenes of one variant. ``random`` uses seed 0 only."""
-    from gift.core.queries import QueryProblem, ask, labels_answerer
+    from gift.core.queries import QueryProblem, asking, labels_answerer
 
     counts = np.zeros((len(ks), 3))
     for view, labels in per[variant]["views"].values():
         y = np.array([labels[t] for t in view.test], dtype=bool)
+        # one session of max(ks) questions: the state after k of them (the last when every object was asked)
+        states = list(asking(QueryProblem.of(view, "train-calibrated"), policy, labels_answerer(labels), max(ks),
+                             seed=0))
         for i, k in enumerate(ks):
-            state = ask(QueryProblem.of(view, "train-calibrated"), policy, labels_answerer(labels), k, seed=0)
-            m = binary_metrics(np.asarray(state.predicted, dtype=bool), y)
+            m = binary_metrics(np.asarray(states[min(k, len(states) - 1)].predicted, dtype=bool), y)
             counts[i] += (m.tp, m.fp, m.fn)
     return counts
 
