@@ -250,7 +250,7 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
     with pytest.raises(GiftError, match="conditions on an intent"):
         GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).score(TEST, TRAIN, None)
     for bad in ({"template": "nope"}, {"combine": "mean"}, {"weight": 2.0}, {"embed_reference": "x"},
-                {"standardize": "y"}, {"embed_text": "name"}):
+                {"standardize": "y"}, {"embed_text": "name"}, {"ask_text": "name"}):
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
@@ -267,6 +267,32 @@ def test_every_relevance_template_asks_one_yes_no_question_about_the_object():
         assert ("cheeses" in user.content) == ("{category}" in template)
     kind = prompts.relevance_messages(obj, "keep the mug away from the cheese", "kind", category="cheeses")[1].content
     assert "(a steel box with rasps)" in kind and "itself one of the cheeses" in kind
+
+
+def test_a_question_on_the_description_alone_never_shows_the_name():
+    obj = gift.ObjectSpec("cheese grater", description="A steel box with rasps for shredding hard blocks.")
+    for name in prompts.RELEVANCE_TEMPLATES:
+        user = prompts.relevance_messages(obj, "keep the mug away from the cheese", name, category="cheeses",
+                                          object_text="description")[1].content
+        assert "grater" not in user and 'a thing described as "A steel box with rasps for shredding hard blocks"' \
+            in user and user.endswith("Answer yes or no."), user
+    bare = gift.ObjectSpec("cheese grater")  # no description: the name is all there is to show
+    assert "a cheese grater one of the cheeses" in prompts.relevance_messages(
+        bare, "g", category="cheeses", object_text="description")[1].content
+    with pytest.raises(GiftError, match="object_text must be one of"):
+        prompts.relevance_messages(obj, "g", object_text="name")
+
+
+def test_ask_text_both_averages_the_log_odds_of_the_named_and_the_described_question():
+    def probs(text):  # 0.9 when the question names the object, 0.2 when it shows the description alone
+        return {"yes": 0.2, "no": 0.8} if "described as" in text else {"yes": 0.9, "no": 0.1}
+
+    lo = {t: GiftProbKernel(lm=ScriptedLM(lambda m, s: category_json("art supplies"), probs), combine="none",
+                            ask_text=t).log_odds(TEST[:2], ART)
+          for t in ("name+description", "description", "both")}
+    assert np.allclose(lo["name+description"], np.log(9)) and np.allclose(lo["description"], np.log(0.25))
+    assert np.allclose(lo["both"], (np.log(9) + np.log(0.25)) / 2)
+    assert "ask_text='both'" in repr(GiftProbKernel(ask_text="both"))
 
 
 def test_goal_text_turns_motivation_sentences_into_goal_clauses():

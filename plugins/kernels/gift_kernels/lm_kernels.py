@@ -236,6 +236,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 COMBINE = ("none", "language")
 EMBED_REFERENCE = ("relevant", "contrastive")
 EMBED_TEXT = ("name+description", "description")
+ASK_TEXT = ("name+description", "description", "both")
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
@@ -286,7 +287,9 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``), ``ask_text`` (how
+    the LM's yes/no questions show each object: ``"name+description"``, the default, ``"description"`` or
+    ``"both"``, the mean log-odds of the two), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
@@ -315,7 +318,7 @@ class GiftProbKernel(RelevanceKernel):
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
-                 embed_text: str = "description") -> None:
+                 embed_text: str = "description", ask_text: str = "name+description") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -330,6 +333,13 @@ class GiftProbKernel(RelevanceKernel):
         #: by a rule written before it was run (train-calibrated F1 0.767 -> 0.788 pooled over both intent
         #: sources; docs/results/front_half.md, section 19).
         self.embed_text = embed_text
+        if ask_text not in ASK_TEXT:
+            raise GiftError(f"gift-prob: ask_text must be one of {ASK_TEXT}, got {ask_text!r}")
+        #: How each object is shown in the LM's yes/no questions (:data:`gift_kernels.prompts.OBJECT_TEXT`):
+        #: ``"name+description"`` (the default), ``"description"`` (no name: "a thing described as ..."), or
+        #: ``"both"`` (both questions asked, their log-odds averaged). A candidate against distractors named like
+        #: the goal's class (docs/results/front_half.md, section 20).
+        self.ask_text = ask_text
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
@@ -422,7 +432,7 @@ class GiftProbKernel(RelevanceKernel):
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
-                f"embed_text={self.embed_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
+                f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
                 f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
                 f"calibration={self.calibration_spec!r}, "
                 f"language_kernel={'default' if self._language is None else repr(self._language)})")
@@ -639,9 +649,11 @@ class GiftProbKernel(RelevanceKernel):
         elif len(categories) != len(objects):
             raise GiftError(f"gift-prob: {len(categories)} categories for {len(objects)} objects")
         out = np.empty(len(objects))
+        shown = ("name+description", "description") if self.ask_text == "both" else (self.ask_text,)
         for i, o in enumerate(objects):
-            s = self._ask(prompts.relevance_messages(o, intent.text, self.template, self.use_descriptions,
-                                                     categories[i]))
+            s = float(np.mean([self._ask(prompts.relevance_messages(o, intent.text, self.template,
+                                                                    self.use_descriptions, categories[i], text))
+                               for text in shown]))
             if self.axes:
                 for a in intent.axes:
                     s = max(s, self._ask(prompts.axis_messages(o, a.question, self.use_descriptions)))

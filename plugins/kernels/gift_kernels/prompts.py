@@ -17,6 +17,7 @@ import re
 from collections.abc import Mapping, Sequence
 
 from gift.core.data import DISTRACTOR, Intent, Message, ObjectSpec
+from gift.core.errors import GiftError
 
 # ----------------------------------------------------------------------------- Call 1: intent
 
@@ -328,11 +329,26 @@ def fallback_category(goal: str) -> str:
     return f'things the goal "{goal_text(goal)}" is about'
 
 
+#: How the object is shown in a yes/no question: ``"name+description"`` ("a cheese grater (A four-sided steel box
+#: ...)") or ``"description"`` ("a thing described as "A four-sided steel box ..."": no name, so that a word the
+#: name shares with the category cannot carry the answer; the name when the object has no description).
+OBJECT_TEXT = ("name+description", "description")
+
+
 def relevance_messages(obj: ObjectSpec, goal: str, template: str = "category",
-                       use_description: bool = True, category: str | None = None) -> tuple[Message, ...]:
-    """One yes/no question: is ``obj`` something the goal is about (one of its ``category``)?"""
-    desc = f" ({obj.description.strip()})" if use_description and obj.description.strip() else ""
-    body = RELEVANCE_TEMPLATES[template].format(goal=goal_text(goal), name=obj.name, desc=desc,
+                       use_description: bool = True, category: str | None = None,
+                       object_text: str = "name+description") -> tuple[Message, ...]:
+    """One yes/no question: is ``obj`` something the goal is about (one of its ``category``)?
+    ``object_text``: one of :data:`OBJECT_TEXT`."""
+    if object_text not in OBJECT_TEXT:
+        raise GiftError(f"relevance question: object_text must be one of {OBJECT_TEXT}, got {object_text!r}")
+    described = obj.description.strip()
+    if object_text == "description" and described:
+        name, desc = f'thing described as "{described.rstrip(".")}"', ""
+    else:
+        name = obj.name
+        desc = f" ({described})" if use_description and described else ""
+    body = RELEVANCE_TEMPLATES[template].format(goal=goal_text(goal), name=name, desc=desc,
                                                 category=category or fallback_category(goal))
     return (Message("system", RELEVANCE_SYSTEM), Message("user", body))
 
