@@ -27,6 +27,8 @@ DEV6_LABEL = {"cheeses": "i1a", "bee_products": "i1b", "dried_flowers": "i2a", "
               "alcoholic_drinks": "i3a", "cycling_kit": "i3b", "fire_lighting": "i4a", "openers": "i4b"}
 DEV7_LABEL = {"citrus_fruit": "j1a", "awards": "j1b", "sugar": "j2a", "mushrooms": "j2b",
               "handwear": "j3a", "table_tennis": "j3b", "drinking_straws": "j4a", "table_mats": "j4b"}
+DEV8_LABEL = {"vinyl_records": "k1a", "photographic_film": "k1b", "pasta": "k2a", "magnets": "k2b",
+              "golf_kit": "k3a", "cricket_kit": "k3b", "neckwear": "k4a", "pest_control": "k4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -78,6 +80,7 @@ def main() -> None:
     paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
     dev3, dev4, dev5 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4"), gift.load_suite("gift-dev5")
     dev6, dev7 = gift.load_suite("gift-dev6"), gift.load_suite("gift-dev7")
+    dev8 = gift.load_suite("gift-dev8")
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
     doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
@@ -94,6 +97,8 @@ def main() -> None:
     doc = put(doc, "gift-dev6:intents", intent_tables(dev6, DEV6_LABEL))
     doc = put(doc, "gift-dev7:summary", summary(dev7, DEV7_LABEL, "label"))
     doc = put(doc, "gift-dev7:intents", intent_tables(dev7, DEV7_LABEL))
+    doc = put(doc, "gift-dev8:summary", summary(dev8, DEV8_LABEL, "label"))
+    doc = put(doc, "gift-dev8:intents", intent_tables(dev8, DEV8_LABEL))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
     doc = catalog_size(doc, "gift-dev", len(dev.objects))
     doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
@@ -102,6 +107,7 @@ def main() -> None:
     doc = catalog_size(doc, "gift-dev5", len(dev5.objects))
     doc = catalog_size(doc, "gift-dev6", len(dev6.objects))
     doc = catalog_size(doc, "gift-dev7", len(dev7.objects))
+    doc = catalog_size(doc, "gift-dev8", len(dev8.objects))
     DOC.write_text(doc, encoding="utf-8")
 
 

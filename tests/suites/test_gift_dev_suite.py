@@ -1,5 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6`` and ``gift-dev7``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev6``, ``gift-dev7`` and ``gift-dev8``: new intents and objects, none borrowed from the suites they are
+checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -86,6 +87,16 @@ DEV_SUITES = {
                        r"|\bsugar|sucrose|\bsweeten|mushroom|\bfung(?:us|i|al)\b|toadstool|\bmycel"
                        r"|\bglov|mitten|\bmitts?\b|handwear|tennis|ping.?pong"
                        r"|\bstraws?\b|drinking|\bsip(?:s|ped|ping)?\b|coaster|placemat|\bmats?\b",
+    },
+    "gift-dev8": {
+        "siblings": [("vinyl_records", "photographic_film"), ("pasta", "magnets"),
+                     ("golf_kit", "cricket_kit"), ("neckwear", "pest_control")],
+        "label_words": r"\bvinyl|\brecords?\b|\blps?\b|\balbums?\b|gramophone|phonograph"
+                       r"|\bfilms?\b|photograph|\bphotos?\b|\bnegatives?\b"
+                       r"|\bpasta\b|spaghetti|macaroni|\bmagnet"
+                       r"|\bgolf|cricket"
+                       r"|\bties?\b|necktie|neckwear|\bscar(?:f|fs|ves)\b|cravat"
+                       r"|\bpests?\b|pesticid|insecticid|vermin",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
