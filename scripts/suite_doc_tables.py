@@ -75,41 +75,24 @@ def catalog_size(doc: str, name: str, n: int) -> str:
     return before + head + section + sep + after
 
 
+#: Each development suite and its intents' labels, in the order of docs/suites.md.
+DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3": DEV3_LABEL, "gift-dev4": DEV4_LABEL,
+                    "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL}
+
+
 def main() -> None:
     doc = DOC.read_text(encoding="utf-8")
-    paper, dev, dev2 = gift.load_suite("gift-paper"), gift.load_suite("gift-dev"), gift.load_suite("gift-dev2")
-    dev3, dev4, dev5 = gift.load_suite("gift-dev3"), gift.load_suite("gift-dev4"), gift.load_suite("gift-dev5")
-    dev6, dev7 = gift.load_suite("gift-dev6"), gift.load_suite("gift-dev7")
-    dev8 = gift.load_suite("gift-dev8")
+    paper = gift.load_suite("gift-paper")
+    devs = {name: gift.load_suite(name) for name in DEV_SUITE_LABELS}
     doc = put(doc, "gift-paper:summary", summary(paper, PAPER_OMEGA, "paper"))
     doc = put(doc, "gift-paper:intents", intent_tables(paper, PAPER_OMEGA))
-    doc = put(doc, "gift-dev:summary", summary(dev, DEV_LABEL, "label"))
-    doc = put(doc, "gift-dev:intents", intent_tables(dev, DEV_LABEL))
-    doc = put(doc, "gift-dev2:summary", summary(dev2, DEV2_LABEL, "label"))
-    doc = put(doc, "gift-dev2:intents", intent_tables(dev2, DEV2_LABEL))
-    doc = put(doc, "gift-dev3:summary", summary(dev3, DEV3_LABEL, "label"))
-    doc = put(doc, "gift-dev3:intents", intent_tables(dev3, DEV3_LABEL))
-    doc = put(doc, "gift-dev4:summary", summary(dev4, DEV4_LABEL, "label"))
-    doc = put(doc, "gift-dev4:intents", intent_tables(dev4, DEV4_LABEL))
-    doc = put(doc, "gift-dev5:summary", summary(dev5, DEV5_LABEL, "label"))
-    doc = put(doc, "gift-dev5:intents", intent_tables(dev5, DEV5_LABEL))
-    doc = put(doc, "gift-dev6:summary", summary(dev6, DEV6_LABEL, "label"))
-    doc = put(doc, "gift-dev6:intents", intent_tables(dev6, DEV6_LABEL))
-    doc = put(doc, "gift-dev7:summary", summary(dev7, DEV7_LABEL, "label"))
-    doc = put(doc, "gift-dev7:intents", intent_tables(dev7, DEV7_LABEL))
-    doc = put(doc, "gift-dev8:summary", summary(dev8, DEV8_LABEL, "label"))
-    doc = put(doc, "gift-dev8:intents", intent_tables(dev8, DEV8_LABEL))
+    for name, label in DEV_SUITE_LABELS.items():
+        doc = put(doc, f"{name}:summary", summary(devs[name], label, "label"))
+        doc = put(doc, f"{name}:intents", intent_tables(devs[name], label))
     doc = re.sub(r"a catalog of \d+ objects", f"a catalog of {len(paper.objects)} objects", doc)
-    doc = catalog_size(doc, "gift-dev", len(dev.objects))
-    doc = catalog_size(doc, "gift-dev2", len(dev2.objects))
-    doc = catalog_size(doc, "gift-dev3", len(dev3.objects))
-    doc = catalog_size(doc, "gift-dev4", len(dev4.objects))
-    doc = catalog_size(doc, "gift-dev5", len(dev5.objects))
-    doc = catalog_size(doc, "gift-dev6", len(dev6.objects))
-    doc = catalog_size(doc, "gift-dev7", len(dev7.objects))
-    doc = catalog_size(doc, "gift-dev8", len(dev8.objects))
+    for name, suite in devs.items():
+        doc = catalog_size(doc, name, len(suite.objects))
     DOC.write_text(doc, encoding="utf-8")
-
 
 if __name__ == "__main__":
     main()

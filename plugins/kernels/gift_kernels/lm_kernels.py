@@ -236,7 +236,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 COMBINE = ("none", "language")
 EMBED_REFERENCE = ("relevant", "contrastive")
 EMBED_TEXT = ("name+description", "description")
-ASK_TEXT = ("name+description", "description", "both")
+ASK_TEXT = (*prompts.OBJECT_TEXT, "both")  # "both": every object text of a question, log-odds averaged
 STANDARDIZE = ("pooled", "train")
 WEIGHTING = ("reliability", "equal")
 CATEGORY_FROM = ("goal+objects", "goal")
@@ -649,7 +649,7 @@ class GiftProbKernel(RelevanceKernel):
         elif len(categories) != len(objects):
             raise GiftError(f"gift-prob: {len(categories)} categories for {len(objects)} objects")
         out = np.empty(len(objects))
-        shown = ("name+description", "description") if self.ask_text == "both" else (self.ask_text,)
+        shown = prompts.OBJECT_TEXT if self.ask_text == "both" else (self.ask_text,)
         for i, o in enumerate(objects):
             s = float(np.mean([self._ask(prompts.relevance_messages(o, intent.text, self.template,
                                                                     self.use_descriptions, categories[i], text))
