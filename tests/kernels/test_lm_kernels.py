@@ -140,17 +140,30 @@ def test_gift_kernel_keeps_the_valid_part_of_an_answer_still_incomplete_after_th
 # ----------------------------------------------------------------------------- gift-prob control flow
 
 
+NAME_OF = {o.description: o.name for o in (*TRAIN, *TEST)}
+
+
+def _asked(text):
+    """(object name, category) of a yes/no question in either form of ``ask_text``: "Is a <name> (<description>)
+    one of the <category>?" or "Is a thing described as "<description>" one of the <category>?"."""
+    described = re.search(r'Is a thing described as "(.+?)" one of the (.+?)\?', text)
+    if described:
+        return NAME_OF[described.group(1)], described.group(2)
+    return re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+
+
 def _probs_by_name(table):
     def probs(text):
-        name = re.search(r"Is a (.+?) \(", text).group(1)
+        name = _asked(text)[0]
         return {"yes": table[name], "no": 1.0 - table[name]}
     return probs
 
 
 def _probs_by_category(table, default):
-    """P(yes) of "Is a <object> (...) one of the <category>?" from ``table[category][object]``, else ``default``."""
+    """P(yes) of the question about <object> under <category> from ``table[category][object]``, else ``default``
+    (both forms of the question get the same answer)."""
     def probs(text):
-        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        name, cat = _asked(text)
         p = table.get(cat, {}).get(name, default)
         return {"yes": p, "no": 1.0 - p}
     return probs
@@ -171,13 +184,16 @@ def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
         assert np.allclose(K, np.outer([0.7, 0.4, 0.05], [1, 1, 0, 0]))
     n_calls = len(lm.calls)
     k.score(TEST, TRAIN, ART, ("paintbrush", "sketchbook"))
-    assert len(lm.calls) == n_calls == k.calls == 1 + len(TEST) + len(TRAIN)  # each question asked once
-    # first the category, once per goal (greedy, few-shot), then one yes/no question per object
+    # each question asked once: the category, then per object the question with its name and the one with its
+    # description alone (ask_text="both", the default)
+    assert len(lm.calls) == n_calls == k.calls == 1 + 2 * (len(TEST) + len(TRAIN))
+    # first the category, once per goal (greedy, few-shot), then the yes/no questions
     first, questions = lm.calls[0], lm.calls[1:]
     assert first[0][0].content == prompts.CATEGORY_SYSTEM and first[2] == 0.0
     assert first[0][-1].content.startswith("Goal: pack art supplies.") and rs.details["category"] == "Art supplies"
     assert all(m[0][0].content == prompts.RELEVANCE_SYSTEM for m in questions)
     assert questions[0][0][1].content.startswith("Is a crayons (sticks of colored wax) one of the Art supplies?")
+    assert questions[1][0][1].content.startswith('Is a thing described as "sticks of colored wax" one of the Art')
 
 
 def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects_leaving_each_one_out():
@@ -226,8 +242,9 @@ def test_gift_prob_alignment_of_a_scene_asks_only_the_demonstrated_objects_quest
     assert len(asked) == len(set(asked)) == k.calls  # no question twice
     # no goal-only category: K, the relevance and the leave-one-out scores share one scoring pass
     assert not any(a[-1].endswith("Which objects is this goal about?") for a in asked)
-    # 1 + 4 categories (the full one, one without each training object), 3 test and 4 held-out training objects
-    assert len(asked) == 1 + len(TRAIN) + len(TEST) + len(TRAIN)
+    # 1 + 4 categories (the full one, one without each training object), then two questions (ask_text="both")
+    # of each of the 3 test and 4 held-out training objects
+    assert len(asked) == 1 + len(TRAIN) + 2 * (len(TEST) + len(TRAIN))
     assert sc.details["category"] == "art supplies"
 
 
@@ -527,7 +544,7 @@ def test_gift_prob_candidates_are_verified_on_the_training_objects_and_only_the_
            ("art supplies", "paintbrush"): 0.9, ("art supplies", "sketchbook"): 0.8, ("art supplies", "crayons"): 0.85}
 
     def probs(text):
-        name, cat = re.search(r"Is a (.+?) \(.*\) one of the (.+?)\?", text).groups()
+        name, cat = _asked(text)
         p = yes.get((cat, name), 0.1)
         return {"yes": p, "no": 1.0 - p}
 
