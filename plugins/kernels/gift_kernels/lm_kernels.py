@@ -287,9 +287,10 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``), ``ask_text`` (how
-    the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds of the question
-    with the name and the one with the description alone; ``"name+description"``; ``"description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``),
+    ``ask_text`` (how the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds
+    of the question with the name and the one with the description alone; ``"name+description"``;
+    ``"description"``), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
