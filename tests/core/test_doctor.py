@@ -25,7 +25,7 @@ def test_doctor_passes_on_this_install():
     assert proc.returncode == 0, proc.stdout + proc.stderr
     lines = proc.stdout.splitlines()
     assert not [ln for ln in lines if ln.startswith("FAIL")]
-    for name in ("embedded model", "llama.cpp backend", "drake", "EGL (headless renders)", "torch",
+    for name in ("embedded model", "llama.cpp backend", "llama.cpp decodes", "drake", "EGL (headless renders)", "torch",
                  "MiniLM (language kernel)", "EfficientNet-Lite0 (vision kernel)", "cache directories", "plugins"):
         assert any(ln.startswith("ok") and f"  {name}  " in ln for ln in lines), (name, proc.stdout)
     assert "sha256 cc324af070c2... as expected" in proc.stdout  # the model file was hashed, not just stat'ed

@@ -65,3 +65,27 @@ def test_correct_parts_assemble_atomically_with_a_marker(tmp_path, monkeypatch):
     assert embedded.is_verified(dest)
     dest.write_bytes(b"hello WORLD")  # changed after verification: the marker no longer matches
     assert not embedded.is_verified(dest)
+
+
+@pytest.mark.slow
+@pytest.mark.lm
+def test_llama_cpp_decodes_with_the_model_in_a_child_process(embedded_gguf):
+    """The check setup.sh and ``gift doctor`` run: the real llama.cpp build loads the model and decodes."""
+    import subprocess
+    import sys
+
+    ok, what = embedded.decode_check(embedded_gguf)
+    assert ok, what
+    assert what.startswith("llama.cpp decodes with qwen2.5-coder-1.5b-instruct-q4_k_m.gguf: ")
+    proc = subprocess.run([sys.executable, "-m", "gift_llm.embedded", "decode"], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0 and "llama.cpp decodes with" in proc.stdout, proc.stdout + proc.stderr
+
+
+def test_a_file_llama_cpp_cannot_decode_is_reported_not_raised(tmp_path):
+    """A crash or load failure in the child is a (False, reason) naming the file, never an exception here."""
+    bad = tmp_path / "not-a-model.gguf"
+    bad.write_bytes(b"GGUF" + b"\0" * 60)
+    ok, what = embedded.decode_check(bad, timeout=120)
+    assert not ok
+    assert "not-a-model.gguf" in what and ("exit 1" in what or "killed by" in what), what
