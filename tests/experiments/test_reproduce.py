@@ -72,6 +72,9 @@ def test_every_stage_produces_numbers_for_every_kernel(reduced):
     from gift_llm.embedded import EXPECTED_SHA256
 
     assert manifest["lm"]["model_sha256"] == EXPECTED_SHA256 and manifest["lm"]["identity"].startswith("llamacpp:")
+    import llama_cpp  # the build that computed the answers: its version and the CPU kernels it was compiled with
+
+    assert manifest["lm"]["llama_cpp"].startswith(f"{llama_cpp.__version__}; CPU : "), manifest["lm"]
     head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
     assert manifest["git"]["commit"] == head and manifest["suite"]["sha256"] and manifest["code_version"]
     # in inferred mode the relevant training objects come from the demonstrations, not the suite

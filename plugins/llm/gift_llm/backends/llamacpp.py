@@ -173,6 +173,16 @@ def load_llama(path: str | Path, *, n_ctx: int = 4096, n_threads: int | None = N
         return _MODELS[key]
 
 
+def llama_build() -> str:
+    """``"<llama-cpp-python version>; <ggml's CPU features>"``, e.g. ``"0.3.36; CPU : SSE3 = 1 | AVX2 = 1 | ..."``:
+    the build that computes the answers (``-march=native`` and portable builds use different kernels)."""
+    import llama_cpp
+
+    info = llama_cpp.llama_print_system_info()
+    info = info.decode("utf-8", "replace") if isinstance(info, bytes) else str(info)
+    return f"{llama_cpp.__version__}; {' '.join(info.split()).strip(' |')}"
+
+
 @atexit.register
 def _close_all() -> None:
     """Free the shared models before interpreter shutdown (avoids noise from ``Llama.__del__`` at exit)."""
@@ -301,10 +311,13 @@ class LlamaCppLM(LMBackend):
         return n
 
     def provenance(self) -> dict[str, Any]:
-        """Identity, path and SHA-256 of the GGUF file this backend loads (hashed once per file version)."""
+        """Identity, path and SHA-256 of the GGUF file this backend loads (hashed once per file version), and the
+        llama.cpp build that runs it (:func:`llama_build`: kernels built for other instruction sets may answer
+        differently)."""
         from gift.core.provenance import file_sha256
 
-        return {"identity": self.identity(), "model_path": str(self.path), "model_sha256": file_sha256(self.path)}
+        return {"identity": self.identity(), "model_path": str(self.path), "model_sha256": file_sha256(self.path),
+                "llama_cpp": llama_build()}
 
     def _grammar(self, schema: Mapping[str, Any]) -> Any:
         from llama_cpp import LlamaGrammar
