@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7`` and ``gift-dev8``: new intents and objects, none borrowed from the suites they are
-checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8`` and ``gift-dev9``: new intents and objects, none borrowed from the
+suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -97,6 +97,17 @@ DEV_SUITES = {
                        r"|\bgolf|cricket"
                        r"|\bties?\b|necktie|neckwear|\bscar(?:f|fs|ves)\b|cravat"
                        r"|\bpests?\b|pesticid|insecticid|vermin",
+    },
+    "gift-dev9": {
+        "siblings": [("glow_in_the_dark", "cured_meat"), ("wheeled_things", "seaweed"),
+                     ("stargazing_kit", "snooker_kit"), ("earwear", "flags")],
+        "label_words": r"\bglow|\bdark\b|\blumin|phosphor"
+                       r"|\bcured\b|\bcuring\b|\bmeats?\b|salami|\bhams?\b|charcut|jerky|prosciutto"
+                       r"|\bwheel|\bcast[oe]rs?\b|seaweed|\bkelp\b|\balga|\bnori\b"
+                       r"|stargaz|\bstars?\b|\bstarry\b|astronom|telescop|constellat|\bplanets?\b|\bsky\b"
+                       r"|snooker|billiard|\bcues?\b|\bbaize\b"
+                       r"|\bears?\b|\bear(?:rings?|plugs?|buds?|pieces?|phones?)\b|\bhearing\b"
+                       r"|\bflags?\b|\bbanners?\b|\bensigns?\b|\bpennants?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
