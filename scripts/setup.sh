@@ -31,10 +31,31 @@ PIP_NO_DEPS=(drake)
 # llama.cpp: only libllama and libggml are built (no multimodal library, no llama.cpp "common" helpers,
 # tools, tests or examples; scripts/cmake/llama_cpp_minimal.cmake). llama_cpp.server is unaffected.
 LLAMA_CMAKE_ARGS="-DLLAVA_BUILD=OFF -DCMAKE_PROJECT_llama.cpp_INCLUDE=$ROOT/scripts/cmake/llama_cpp_minimal.cmake"
-# x86-64: ggml's portable kernels (SSE4.2, AVX, AVX2, FMA, F16C, BMI2), not -march=native. A native build on a
-# CPU with AMX (a 2-core Xeon VM with amx_tile, 2026-12-04) moves the weights into AMX buffers and segfaults at
-# the first decode; the portable build runs, and runs the same kernels, on every x86-64 machine.
-[ "$(uname -m)" = x86_64 ] && LLAMA_CMAKE_ARGS="$LLAMA_CMAKE_ARGS -DGGML_NATIVE=OFF"
+# x86-64: not -march=native. A native build on a CPU with AMX (a 2-core Xeon VM with amx_tile, 2026-12-04) moves
+# the weights into AMX buffers and segfaults at the first decode. Instead ggml's portable kernels (SSE4.2, AVX,
+# AVX2, FMA, F16C, BMI2) plus the AVX-512 and AVX-VNNI ones this CPU reports in /proc/cpuinfo, never AMX (about
+# 25 % faster decoding on that Xeon than the portable set alone; docs/installation.md).
+# LLAMA_X86_KERNELS lists them by the names llama.cpp's system info prints ("AVX512 = 1"); setup checks the
+# installed build against it, so a wheel cached on another CPU is compiled again.
+llama_x86_kernels() {
+  local flags f
+  flags=" $(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null | cut -d: -f2) "
+  has() { for f in "$@"; do [[ $flags == *" $f "* ]] || return 1; done; }
+  if has avx512f avx512cd avx512vl avx512dq avx512bw; then
+    echo AVX512
+    has avx512vbmi && echo AVX512_VBMI
+    has avx512_vnni && echo AVX512_VNNI
+    has avx512_bf16 && echo AVX512_BF16
+  fi
+  has avx_vnni && echo AVX_VNNI
+  return 0
+}
+LLAMA_X86_KERNELS=""
+if [ "$(uname -m)" = x86_64 ]; then
+  LLAMA_X86_KERNELS=$(llama_x86_kernels | tr '\n' ' ' | sed 's/ $//')
+  LLAMA_CMAKE_ARGS="$LLAMA_CMAKE_ARGS -DGGML_NATIVE=OFF -DGGML_AMX_TILE=OFF -DGGML_AMX_INT8=OFF -DGGML_AMX_BF16=OFF"
+  for k in $LLAMA_X86_KERNELS; do LLAMA_CMAKE_ARGS="$LLAMA_CMAKE_ARGS -DGGML_$k=ON"; done
+fi
 
 # ======================================================================= options
 SET=user
@@ -62,7 +83,8 @@ STATE=$ROOT/.venv/.setup
 # A hash of everything that decides what .venv holds; --if-changed skips the install when it is unchanged.
 setup_hash() {
   { cat scripts/setup.sh constraints.txt scripts/cmake/*.cmake pyproject.toml plugins/*/pyproject.toml
-    echo "python=$("${PY:-python3}" -c 'import sys; print(sys.version.split()[0])' 2>/dev/null)"; } \
+    echo "python=$("${PY:-python3}" -c 'import sys; print(sys.version.split()[0])' 2>/dev/null)"
+    echo "llama.cpp kernels=$LLAMA_X86_KERNELS"; } \
     | sha256sum | cut -d' ' -f1
 }
 
@@ -222,18 +244,36 @@ step "assembling and verifying the embedded model (a no-op when verified)"
 "$VPY" -m gift_llm.embedded install
 step_done
 
-# llama.cpp must decode with it on this CPU (a child process; about 3 s). A wheel from pip's cache may have been
-# built with other flags (before the portable x86-64 build, or on another CPU): then it is dropped and compiled.
-step "llama.cpp decodes with the embedded model"
-if ! "$VPY" -m gift_llm.embedded decode 2>"$STATE/logs/decode.log"; then
-  cat "$STATE/logs/decode.log" >&2
-  log "llama.cpp crashed on this CPU: dropping the installed and cached llama-cpp-python wheel and compiling it"
+# llama.cpp must decode with it on this CPU (a child process; about 3 s) and have the kernels chosen above for it.
+# A wheel from pip's cache may have been built with other flags (before these flags, or on another CPU): then it
+# is dropped and compiled.
+recompile_llama() {
+  log "$1: dropping the installed and cached llama-cpp-python wheel and compiling it"
   "$VPY" -m pip uninstall -y -q llama-cpp-python
   "$VPY" -m pip cache remove "llama_cpp_python-$LLAMA_VERSION-*" >/dev/null 2>&1 || true
   compile_llama
-  "$VPY" -m gift_llm.embedded decode || die "llama.cpp still crashes after compiling it on this machine (see above;
-       .venv/.setup/logs/llama-cpp-python.log has the build)"
+}
+# The x86 kernels (of those chosen above, and AMX) the installed build has, as its system info names them.
+llama_built_kernels() {
+  "$VPY" -c "
+import re, llama_cpp
+info = llama_cpp.llama_print_system_info()
+info = info.decode() if isinstance(info, bytes) else str(info)
+names = ('AVX512', 'AVX512_VBMI', 'AVX512_VNNI', 'AVX512_BF16', 'AVX_VNNI', 'AMX_INT8')
+print(' '.join(k for k in names if re.search(rf'(^|[ |]){k} = 1', info)))"
+}
+step "llama.cpp decodes with the embedded model (x86 kernels: ${LLAMA_X86_KERNELS:-the portable set})"
+built=$(llama_built_kernels 2>/dev/null || echo "?")
+if [ "$(uname -m)" = x86_64 ] && [ "$built" != "$LLAMA_X86_KERNELS" ]; then
+  recompile_llama "the installed llama.cpp has the x86 kernels [${built}], this CPU gets [${LLAMA_X86_KERNELS}]"
+elif ! "$VPY" -m gift_llm.embedded decode 2>"$STATE/logs/decode.log"; then
+  cat "$STATE/logs/decode.log" >&2
+  recompile_llama "llama.cpp crashed on this CPU"
+else
+  built=ok
 fi
+[ "$built" = ok ] || "$VPY" -m gift_llm.embedded decode || die "llama.cpp crashes after compiling it on this machine (see above;
+     .venv/.setup/logs/llama-cpp-python.log has the build)"
 step_done
 
 setup_hash > "$STATE/stamp-user"

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import hashlib
+import platform
+import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -89,3 +92,29 @@ def test_a_file_llama_cpp_cannot_decode_is_reported_not_raised(tmp_path):
     ok, what = embedded.decode_check(bad, timeout=120)
     assert not ok
     assert "not-a-model.gguf" in what and ("exit 1" in what or "killed by" in what), what
+
+
+def _setup_x86_kernels() -> list[str]:
+    """The x86 kernels scripts/setup.sh chooses for this CPU (its ``llama_x86_kernels`` function, run alone)."""
+    setup = Path(__file__).resolve().parents[2] / "scripts" / "setup.sh"
+    text = setup.read_text()
+    start = text.index("llama_x86_kernels() {")
+    body = text[start:text.index("\n}\n", start) + 3]
+    proc = subprocess.run(["bash", "-c", body + "llama_x86_kernels"], capture_output=True, text=True, check=True)
+    return proc.stdout.split()
+
+
+@pytest.mark.skipif(platform.machine() != "x86_64", reason="setup chooses x86 kernels on x86-64 only")
+def test_installed_llama_cpp_has_the_kernels_setup_chooses_for_this_cpu_and_no_amx():
+    """The build answering every LM test is the one setup.sh makes for this CPU: ggml's portable kernels plus the
+    AVX-512 / AVX-VNNI ones /proc/cpuinfo reports, never AMX (a native AMX build segfaults; docs/installation.md)."""
+    from gift_llm.backends.llamacpp import llama_build
+
+    flags = set(Path("/proc/cpuinfo").read_text().split("\nflags", 1)[1].split("\n", 1)[0].split())
+    chosen = _setup_x86_kernels()
+    assert ("AVX512" in chosen) == {"avx512f", "avx512bw", "avx512vl"} <= flags
+    built = llama_build()
+    for name in ("AVX512", "AVX512_VBMI", "AVX512_VNNI", "AVX512_BF16", "AVX_VNNI"):
+        assert (f"| {name} = 1 |" in f"| {built} |") == (name in chosen), (name, built, chosen)
+    assert "AMX" not in built
+    assert "AVX2 = 1" in built  # the portable set is always there
