@@ -497,12 +497,25 @@ class RelevanceScores:
 # ----------------------------------------------------------------------------- LM messages
 
 
+def _cut_within(instance: Any, attribute: Any, cut: int) -> None:
+    if not 0 <= cut <= len(instance.content):
+        raise ValueError(f"Message.cut {cut} is outside the content's {len(instance.content)} characters")
+
+
 @attrs.frozen
 class Message:
+    """One chat message. ``cut``: a hint, not text. The first ``cut`` characters of ``content`` are a piece
+    that many prompts share, such as the object in "Is a <object> one of the <category>?". A backend that
+    evaluates prompts in pieces may evaluate that piece on its own and reuse it. 0 means no hint. It is
+    part of an LM request's cache key, since another split can give slightly different numbers, but it is
+    never sent to a model."""
+
     role: str = attrs.field(validator=attrs.validators.in_(("system", "user", "assistant")))
     content: str = attrs.field(validator=attrs.validators.instance_of(str))
+    cut: int = attrs.field(default=0, converter=int, validator=_cut_within, kw_only=True)
 
     def to_dict(self) -> dict[str, str]:
+        """The message as a chat API takes it (the ``cut`` hint left out)."""
         return {"role": self.role, "content": self.content}
 
 
@@ -512,7 +525,7 @@ def as_messages(messages: Sequence[Message | Mapping[str, str]] | str) -> tuple[
         return (Message("user", messages),)
     out = []
     for m in messages:
-        out.append(m if isinstance(m, Message) else Message(m["role"], m["content"]))
+        out.append(m if isinstance(m, Message) else Message(m["role"], m["content"], cut=m.get("cut", 0)))
     return tuple(out)
 
 

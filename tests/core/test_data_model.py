@@ -106,3 +106,14 @@ def test_messages():
     assert as_messages([{"role": "system", "content": "s"}])[0].role == "system"
     with pytest.raises(ValueError):
         Message("robot", "x")
+
+
+def test_a_messages_cut_hint_stays_within_its_content_and_out_of_what_a_model_is_sent():
+    m = Message("user", "Is a kettle one of the tools?", cut=21)
+    assert m.content[: m.cut] == "Is a kettle one of th" and m.to_dict() == {"role": "user", "content": m.content}
+    assert Message("user", "x").cut == 0 and m != Message("user", m.content)
+    assert as_messages([{"role": "user", "content": "abc", "cut": 2}])[0].cut == 2
+    with pytest.raises(ValueError, match="cut 9 is outside the content's 3 characters"):
+        Message("user", "abc", cut=9)
+    with pytest.raises(ValueError, match="outside"):
+        Message("user", "abc", cut=-1)

@@ -630,6 +630,44 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
         prompts.ladder_messages([], ["banana"])
 
 
+def test_gift_prob_asks_a_scenes_questions_object_by_object_with_the_scores_of_asking_them_category_by_category():
+    """score() first collects the scene's yes/no questions (no LM call for them), then asks them grouped by
+    object: each question carries a cut hint ending before its category, and the questions sharing the text
+    before it are asked one after another, each once. The scores are those of asking category by category."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.8},
+           "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.8}}
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+
+    def run(by_object: bool):
+        lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
+        k = GiftProbKernel(lm=lm, combine="none", rungs="breadth")
+        if not by_object:
+            k._in_object_order = lambda run: None  # the order before: category by category
+        rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+        asked = [c[0][-1] for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM]
+        return rs, asked
+
+    rs, asked = run(True)
+    before, asked_before = run(False)
+    assert len({m.content for m in asked}) == len(asked) == len(asked_before)  # each question once, no extra
+    assert sorted(m.content for m in asked) == sorted(m.content for m in asked_before)
+    for m in asked:  # the hint ends right before the category, after the object as shown
+        assert m.cut > 0 and m.content[: m.cut].startswith("Is a ") and m.content[: m.cut].endswith(" one of the ")
+    heads = [m.content[: m.cut] for m in asked]
+    runs = [h for i, h in enumerate(heads) if i == 0 or heads[i - 1] != h]
+    assert len(runs) == len(set(heads)) < len(heads)  # one run of questions per object (as shown)
+    heads_before = [m.content[: m.cut] for m in asked_before]
+    assert len([h for i, h in enumerate(heads_before) if i == 0 or heads_before[i - 1] != h]) > len(runs)
+    np.testing.assert_array_equal(rs.relevance, before.relevance)
+    np.testing.assert_array_equal(rs.train_loo, before.train_loo)
+    assert rs.details == before.details
+
+
 def test_gift_prob_ladder_that_names_nothing_warns_and_keeps_the_goals_category():
     """A ladder answer with no usable name (after the repairs) is no rung: a warning names the objects, and the
     scene is scored under the goal's category alone, as without the ladder."""

@@ -132,3 +132,15 @@ def test_no_secret_is_stored(tmp_path, monkeypatch):
     lm.complete(MSG)
     rows = sqlite3.connect(tmp_path / "c.sqlite").execute("SELECT * FROM entries").fetchall()
     assert rows and "sk-test-secret" not in json.dumps(rows)
+
+
+def test_a_cut_hint_is_part_of_the_request_key_and_no_hint_keys_as_before():
+    from gift.core.data import Message
+    from gift_llm.requests import choices_request, request_key
+
+    plain = [Message("system", "s"), Message("user", "Is a kettle one of the tools?")]
+    hinted = [plain[0], Message("user", plain[1].content, cut=23)]
+    as_dicts = [m.to_dict() for m in plain]
+    assert request_key("lm", choices_request(plain, ["yes", "no"])) == request_key("lm", choices_request(as_dicts, ["yes", "no"]))
+    assert request_key("lm", choices_request(hinted, ["yes", "no"])) != request_key("lm", choices_request(plain, ["yes", "no"]))
+    assert choices_request(hinted, ["yes", "no"])["messages"][1]["cut"] == 23

@@ -103,6 +103,35 @@ def test_few_shot_prompts_reuse_all_but_the_last_message_and_stay_exact(embedded
         np.testing.assert_array_equal(logits, got["fresh"][0], err_msg=name)
 
 
+def hinted(category: str, obj: str = "paintbrush (a tool for applying paint)") -> list[dict]:
+    """A yes/no question with the cut hint gift-prob gives it: before the category."""
+    content = f"Is a {obj} one of the {category}? Answer yes or no."
+    return [SYSTEM, {"role": "user", "content": content, "cut": content.index(category)}]
+
+
+@pytest.mark.slow
+@pytest.mark.lm
+def test_a_cut_hint_is_one_more_piece_that_questions_about_the_same_object_reuse_exactly(embedded_lm):
+    """A hint in the last message cuts it where the hinted text stops agreeing with the prompt's tokens: the
+    same tokens as without it, one more piece. A question about the same object under another category
+    reuses that piece; the numbers are the same whatever came before. Against the unhinted prompt (another
+    split into decode batches) they are close, not equal."""
+    prompt = embedded_lm.chat_prompt(hinted("art supplies"))
+    plain = embedded_lm.chat_prompt(QUESTION)
+    assert prompt.tokens == plain.tokens and prompt.starts[0] == plain.starts[0] and len(prompt.starts) == 2
+    piece = embedded_lm.llama.detokenize(list(prompt.tokens[prompt.starts[0]:prompt.starts[1]])).decode()
+    assert piece.endswith("Is a paintbrush (a tool for applying paint) one of the"), piece
+    before = {"fresh": None, "same object": hinted("office things"), "other object": hinted("art supplies", "stapler"),
+              "unrelated": UNRELATED}
+    got = _situations(embedded_lm, before, lambda: embedded_lm.next_token_logits(prompt))
+    assert {k: r for k, (_, r) in got.items()} == {"fresh": 0, "same object": prompt.starts[1],
+                                                   "other object": prompt.starts[0], "unrelated": 0}
+    for name, (logits, _) in got.items():
+        np.testing.assert_array_equal(logits, got["fresh"][0], err_msg=name)
+    unhinted = _situations(embedded_lm, {"fresh": None}, lambda: embedded_lm.next_token_logits(plain))["fresh"][0]
+    assert np.abs(unhinted - got["fresh"][0]).max() < 1.0 and int(np.argmax(unhinted)) == int(np.argmax(got["fresh"][0]))
+
+
 class EvalLog:
     """Records ``(first position, tokens)`` of every ``llama.eval`` call."""
 

@@ -348,9 +348,13 @@ def relevance_messages(obj: ObjectSpec, goal: str, template: str = "category",
     else:
         name = obj.name
         desc = f" ({described})" if use_description and described else ""
-    body = RELEVANCE_TEMPLATES[template].format(goal=goal_text(goal), name=name, desc=desc,
-                                                category=category or fallback_category(goal))
-    return (Message("system", RELEVANCE_SYSTEM), Message("user", body))
+    fields = dict(goal=goal_text(goal), name=name, desc=desc)
+    body = RELEVANCE_TEMPLATES[template].format(**fields, category=category or fallback_category(goal))
+    # the cut hint: the text before the category, which every question about this object under this
+    # template shares (0 when the category does not come after the object)
+    head = RELEVANCE_TEMPLATES[template].split("{category}")[0]
+    cut = len(head.format(**fields)) if "{category}" in RELEVANCE_TEMPLATES[template] and "{name}" in head else 0
+    return (Message("system", RELEVANCE_SYSTEM), Message("user", body, cut=cut))
 
 
 def axis_messages(obj: ObjectSpec, question: str, use_description: bool = True) -> tuple[Message, ...]:
