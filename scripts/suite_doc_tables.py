@@ -31,6 +31,8 @@ DEV8_LABEL = {"vinyl_records": "k1a", "photographic_film": "k1b", "pasta": "k2a"
               "golf_kit": "k3a", "cricket_kit": "k3b", "neckwear": "k4a", "pest_control": "k4b"}
 DEV9_LABEL = {"glow_in_the_dark": "l1a", "cured_meat": "l1b", "wheeled_things": "l2a", "seaweed": "l2b",
               "stargazing_kit": "l3a", "snooker_kit": "l3b", "earwear": "l4a", "flags": "l4b"}
+DEV10_LABEL = {"eggs": "m1a", "doorstops": "m1b", "root_vegetables": "m2a", "coconut_things": "m2b",
+               "ironing_kit": "m3a", "lawn_bowls_kit": "m3b", "hinged_things": "m4a", "bookends": "m4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -80,7 +82,7 @@ def catalog_size(doc: str, name: str, n: int) -> str:
 #: Each development suite and its intents' labels, in the order of docs/suites.md.
 DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3": DEV3_LABEL, "gift-dev4": DEV4_LABEL,
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
-                    "gift-dev9": DEV9_LABEL}
+                    "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL}
 
 
 def main() -> None:

@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7``, ``gift-dev8`` and ``gift-dev9``: new intents and objects, none borrowed from the
-suites they are checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9`` and ``gift-dev10``: new intents and objects, none
+borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -108,6 +108,17 @@ DEV_SUITES = {
                        r"|snooker|billiard|\bcues?\b|\bbaize\b"
                        r"|\bears?\b|\bear(?:rings?|plugs?|buds?|pieces?|phones?)\b|\bhearing\b"
                        r"|\bflags?\b|\bbanners?\b|\bensigns?\b|\bpennants?\b",
+    },
+    "gift-dev10": {
+        "siblings": [("eggs", "doorstops"), ("root_vegetables", "coconut_things"),
+                     ("ironing_kit", "lawn_bowls_kit"), ("hinged_things", "bookends")],
+        "label_words": r"\beggs?\b|eggshell|\byolks?\b|albumen"
+                       r"|doorstop|\bdoors?\b|\bwedges?\b"
+                       r"|\broots?\b|vegetabl|\bveg\b|\bveggies\b|carrot|parsnip|\bbeet|turnip|\bswedes?\b|radish"
+                       r"|potato|celeriac|salsify|\bmooli\b|coconut|\bcocos?\b|\bcoir\b|\bcopra\b|\bbuko\b"
+                       r"|\biron(?:s|ed|ing)?\b|\bcreas(?:e|es|ed|ing)\b|\bwrinkl"
+                       r"|\bbowls?\b|\blawn\b|\bjacks?\b|\bbowling\b|\bbowlers?\b"
+                       r"|\bhinge|\bbook|\bends?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
