@@ -264,15 +264,16 @@ print(' '.join(k for k in names if re.search(rf'(^|[ |]){k} = 1', info)))"
 }
 step "llama.cpp decodes with the embedded model (x86 kernels: ${LLAMA_X86_KERNELS:-the portable set})"
 built=$(llama_built_kernels 2>/dev/null || echo "?")
+decoded=0  # 1 once the installed build has decoded here
 if [ "$(uname -m)" = x86_64 ] && [ "$built" != "$LLAMA_X86_KERNELS" ]; then
   recompile_llama "the installed llama.cpp has the x86 kernels [${built}], this CPU gets [${LLAMA_X86_KERNELS}]"
 elif ! "$VPY" -m gift_llm.embedded decode 2>"$STATE/logs/decode.log"; then
   cat "$STATE/logs/decode.log" >&2
   recompile_llama "llama.cpp crashed on this CPU"
 else
-  built=ok
+  decoded=1
 fi
-[ "$built" = ok ] || "$VPY" -m gift_llm.embedded decode || die "llama.cpp crashes after compiling it on this machine (see above;
+[ "$decoded" = 1 ] || "$VPY" -m gift_llm.embedded decode || die "llama.cpp crashes after compiling it on this machine (see above;
      .venv/.setup/logs/llama-cpp-python.log has the build)"
 step_done
 
