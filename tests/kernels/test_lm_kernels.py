@@ -824,3 +824,80 @@ def test_gift_prob_answers_re_weigh_the_re_named_rungs_by_the_same_check():
     z = [(v - v.mean()) / v.std() for v in views]
     lo = 0.5 * z[1] + 0.5 * z[2]
     assert np.allclose(rs.relevance, 1.0 / (1.0 + np.exp(-lo[: len(TEST)])))
+
+
+def test_gift_prob_answers_as_evidence_drop_a_category_that_ranks_an_answered_no_high_without_lm_calls():
+    """rescore_with="evidence": no LM call; the answered test objects join the training objects in the check,
+    so a rung that fits the training objects but puts the toothbrush (answered "no") with them is dropped."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "brush things", "middle": "art supplies", "broad": "none"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9},
+           "brush things": {"paintbrush": 0.9, "sketchbook": 0.6, "toothbrush": 0.9},
+           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9}}
+    lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit", rescore_with="evidence")
+    rel = ("paintbrush", "sketchbook")
+    base = k.score(TEST, TRAIN, inferred, rel)
+    assert base.details["ladder"]["check"]["in_sample_auc"] == [0.25, 1.0, 1.0]
+    assert np.allclose(base.details["ladder"]["check"]["weights"], [0.0, 0.5, 0.5])
+    n_calls = len(lm.calls)
+    rs = k.score_with_answers(TEST, TRAIN, inferred, rel, {"toothbrush": False})
+    assert len(lm.calls) == n_calls  # nothing new asked
+    assert rs.details["evidence"] == {"yes": [], "no": ["toothbrush"]}
+    check = rs.details["ladder"]["check"]
+    # brush things: paintbrush ties the toothbrush, the sketchbook is under it -> AUC (2 + 2 + 0.5) / 6
+    assert check["in_sample_auc"][1] == pytest.approx(0.75) and check["in_sample_auc"][2] == 1.0
+    assert np.allclose(check["weights"], [0.0, 0.0, 1.0])
+    art = np.asarray(rs.details["ladder"]["terms"][1]["test"] + rs.details["ladder"]["terms"][1]["train"])
+    z = (art - art.mean()) / art.std()
+    assert np.allclose(rs.relevance, 1.0 / (1.0 + np.exp(-z[: len(TEST)])))
+    assert k.score_with_answers(TEST, TRAIN, inferred, rel, {}) is None
+    with pytest.raises(GiftError, match="rescore_with"):
+        GiftProbKernel(rescore_with="again")
+
+
+def test_gift_prob_answers_as_evidence_are_references_of_the_minilm_term_and_weigh_the_terms():
+    """rescore_with="evidence" with the MiniLM term (true intent, no ladder): an object answered "no" is a
+    reference of the left-alone side (never its own), and the answered objects count in the reliability weights."""
+    table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
+             "toothbrush": 0.6, "apple": 0.05}
+    vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
+           "crayons": [0.95, 0.05, 0], "toothbrush": [0.8, 0, 0.6], "apple": [0, 1, 0.1]}
+    lm = ScriptedLM(answer=lambda m, s: category_json("art supplies"), probs=_probs_by_name(table))
+    k = GiftProbKernel(lm=lm, language_kernel=TableKernel(vec), rescore_with="evidence")
+    rel = ("paintbrush", "sketchbook")
+    base = k.score(TEST, TRAIN, ART, rel)
+    n_calls = len(lm.calls)
+    rs = k.score_with_answers(TEST, TRAIN, ART, rel, {"toothbrush": False, "crayons": True})
+    assert len(lm.calls) == n_calls
+    sim = TableKernel(vec).similarity
+    refs = TRAIN + [TEST[1], TEST[0]]  # the training objects, then the answered ones in test order
+    ref_rel = np.array([True, True, False, False, False, True])
+
+    def contrast(obj, own):
+        s = sim([obj], refs)[0]
+        s[own] = np.nan
+        return np.nanmax(np.where(ref_rel, s, np.nan)) - np.nanmax(np.where(~ref_rel, s, np.nan))
+
+    want_test = [contrast(TEST[0], [5]), contrast(TEST[1], [4]), contrast(TEST[2], [])]
+    want_train = [contrast(o, [i]) for i, o in enumerate(TRAIN)]
+    assert np.allclose(rs.details["terms"]["language"]["test"], want_test)
+    assert np.allclose(rs.details["terms"]["language"]["train"], want_train)
+    # the toothbrush (answered "no") is now the sketchbook's nearest left-alone reference: its score falls
+    assert rs.details["terms"]["language"]["train"][1] < base.details["terms"]["language"]["train"][1] - 0.5
+    # the reliability weights: each term's max(AUC - 1/2, 0) over the training and the answered objects
+    from gift.core.metrics import roc_auc
+
+    lab = np.array([True, True, False, False, True, False])  # TRAIN, then crayons (yes), toothbrush (no)
+    sep = {}
+    for t in ("lm", "language"):
+        v = np.asarray(rs.details["terms"][t]["test"] + rs.details["terms"][t]["train"])
+        z = (v - v.mean()) / v.std()
+        sep[t] = max(roc_auc(np.concatenate([z[3:], z[[0, 1]]]), lab) - 0.5, 0.0) * 0.5
+    assert rs.details["weights"] == pytest.approx({t: sep[t] / sum(sep.values()) for t in sep})
+    assert rs.details["evidence"] == {"yes": ["crayons"], "no": ["toothbrush"]}
+    assert GiftProbKernel().rescore_with == "ladder"  # the default

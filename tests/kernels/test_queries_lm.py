@@ -149,6 +149,52 @@ def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
     assert kernel.calls == calls and np.array_equal(again.predicted, after.predicted)
 
 
+def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene, monkeypatch):
+    """rescore_with="evidence" on the real kernel (an inferred intent: the ladder and MiniLM on): the answers
+    re-weigh the ladder's categories and the MiniLM references with no new LM question; the check's AUCs are
+    the training objects' in-sample log-odds pooled with the answered objects', and no object is its own
+    MiniLM reference."""
+    from gift.core.metrics import roc_auc
+
+    kernel, test, train, _, spec, _, labels = scene
+    inferred = Intent(text=spec.text, source="inferred")
+    first = score_alignment(kernel, test, train, inferred, relevant_train=spec.relevant_train)
+    monkeypatch.setattr(kernel, "rescore_with", "evidence")
+    rescore = kernel_rescorer(kernel, test, train, inferred, relevant_train=spec.relevant_train)
+    calls = kernel.calls
+    states = list(asking(QueryProblem.of(first, rescore=rescore), "uncertainty", labels_answerer(labels), 2))
+    assert kernel.calls == calls  # nothing new asked of the LM
+    assert [s.rescored for s in states] == [False, True, True]
+    after = states[-1]
+    det = after.scores.details
+    answered = {a.object: a.relevant for a in after.answers}
+    assert det["evidence"] == {"yes": [t for t in TEST if answered.get(t) is True],
+                               "no": [t for t in TEST if answered.get(t) is False]}
+    # the check: each category's AUC over the training objects (in-sample) and the answered test objects
+    lad = det["ladder"]
+    assert lad["categories"] == first.details["ladder"]["categories"]  # no category named again
+    idx = [TEST.index(t) for t in TEST if t in answered]
+    rel = np.asarray(first.relevant_mask, dtype=bool)
+    cats = [det["category"], *lad["categories"]]
+    views = [np.asarray(lad["goal"])] + [np.asarray(t["test"] + t["train"]) for t in lad["terms"]]
+    for c, v, auc in zip(cats, views, lad["check"]["in_sample_auc"]):
+        lo_train = kernel.log_odds(train, inferred, [c] * len(train))
+        want = roc_auc(np.concatenate([lo_train, v[idx]]), np.concatenate([rel, [answered[TEST[i]] for i in idx]]))
+        assert auc == pytest.approx(want)
+    assert kernel.calls == calls  # the in-sample questions were remembered from the first scoring
+    # MiniLM: contrastive similarity to the training objects and the answered objects, never to itself
+    refs = list(train) + [test[i] for i in idx]
+    ref_rel = np.concatenate([rel, [answered[TEST[i]] for i in idx]])
+    sim = np.asarray(kernel.language.similarity(list(test), refs), dtype=float)
+    for j, i in enumerate(idx):
+        sim[i, len(train) + j] = np.nan
+    want = np.nanmax(np.where(ref_rel, sim, np.nan), axis=1) - np.nanmax(np.where(~ref_rel, sim, np.nan), axis=1)
+    assert np.allclose(det["terms"]["language"]["test"], want)
+    for i, t in enumerate(TEST):
+        a = after.answer_of(t)
+        assert after.predicted[i] == (labels[t] if a is not None else after.scores.decision[i] >= after.cut)
+
+
 def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_not_to(tmp_path, capsys):
     """``gift evaluate-alignment --queries 1`` on one intent with gift-prob's ladder on: the answer re-names the
     ladder (rule 5) with ``--rescore``; without it, the session only re-thresholds the same first scores."""

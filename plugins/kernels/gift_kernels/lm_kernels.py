@@ -245,6 +245,10 @@ SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
 RUNGS = ("breadth", "facets", "both")
 CHECK = ("none", "fit", "weight")
+#: How :meth:`GiftProbKernel.score_with_answers` uses the human's answers: ``"ladder"`` names the category ladder
+#: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
+#: as labelled evidence beside the training objects.
+RESCORE_WITH = ("ladder", "evidence")
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -305,7 +309,9 @@ class GiftProbKernel(RelevanceKernel):
     kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``), ``check``
     (``"fit"``, the default: each of the ladder's categories is first asked of the training objects as named and
     kept only if it puts every demonstrated object above every left-alone one; ``"weight"``: weighted by its
-    AUC - 1/2 there; ``"none"``: all averaged as they are). The defaults were chosen on the development suites,
+    AUC - 1/2 there; ``"none"``: all averaged as they are), ``rescore_with`` (what the human's answers do when the
+    scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"``, the default, names the ladder again with
+    them; ``"evidence"`` asks the LM nothing new and counts them beside the training objects). The defaults were chosen on the development suites,
     docs/results/front_half.md (sections 10-14).
     """
 
@@ -319,7 +325,7 @@ class GiftProbKernel(RelevanceKernel):
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
-                 embed_text: str = "description", ask_text: str = "both") -> None:
+                 embed_text: str = "description", ask_text: str = "both", rescore_with: str = "ladder") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -342,6 +348,13 @@ class GiftProbKernel(RelevanceKernel):
         #: gift-dev8 by a rule written before it was run (train-calibrated F1 0.825 -> 0.838 pooled over both
         #: intent sources; docs/results/front_half.md, section 20).
         self.ask_text = ask_text
+        if rescore_with not in RESCORE_WITH:
+            raise GiftError(f"gift-prob: rescore_with must be one of {RESCORE_WITH}, got {rescore_with!r}")
+        #: What answers do when the scene is re-scored with them (:meth:`score_with_answers`; only when the
+        #: caller re-scores, e.g. ``--rescore``): ``"ladder"`` (the ladder named again with them, LM calls) or
+        #: ``"evidence"`` (no LM call: the answered test objects join the training objects as labelled
+        #: evidence in the check of the categories, the MiniLM term's references and the terms' weights).
+        self.rescore_with = rescore_with
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
@@ -437,7 +450,7 @@ class GiftProbKernel(RelevanceKernel):
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
-                f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
+                f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, rescore_with={self.rescore_with!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
                 f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
                 f"calibration={self.calibration_spec!r}, "
                 f"language_kernel={'default' if self._language is None else repr(self._language)})")
@@ -612,24 +625,34 @@ class GiftProbKernel(RelevanceKernel):
         return self._mix_views(train, intent, rel, [lo, *rungs], [details.get("category"), *full], details["ladder"])
 
     def _mix_views(self, train: Sequence[ObjectSpec], intent: Intent, rel: np.ndarray, views: Sequence[np.ndarray],
-                   categories: Sequence[str | None], record: dict[str, Any]) -> np.ndarray:
+                   categories: Sequence[str | None], record: dict[str, Any],
+                   evidence: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """The LM term ``[n_test + n_train]``: the z-scored log-odds ``views`` (one per category: the goal's,
         then each rung's) averaged, with ``check`` weighted by :meth:`_check_weights`. The one place where the
-        ladder's categories are weighed, used by :meth:`score` and :meth:`score_with_answers`."""
+        ladder's categories are weighed, used by :meth:`score` and :meth:`score_with_answers`. ``evidence``:
+        (indices of labelled test objects, their labels), checked beside the training objects."""
         z = np.stack([_zscore(v) for v in views])
         if self.check == "none":
             return z.mean(axis=0)
-        weights = self._check_weights(train, intent, rel, categories, record)
+        extra = None if evidence is None else ([np.asarray(v)[evidence[0]] for v in views], evidence[1])
+        weights = self._check_weights(train, intent, rel, categories, record, extra)
         return np.tensordot(weights, z, axes=1) / weights.sum()
 
     def _check_weights(self, train: Sequence[ObjectSpec], intent: Intent, rel: np.ndarray,
-                       categories: Sequence[str | None], record: dict[str, Any]) -> np.ndarray:
+                       categories: Sequence[str | None], record: dict[str, Any],
+                       evidence: tuple[Sequence[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
         """``[n_categories]`` weights of the ladder's categories (``check``), from each category's in-sample AUC
-        on the training objects (``rel`` ``[n_train]``: demonstrated or not); recorded in ``record["check"]``."""
+        on the training objects (``rel`` ``[n_train]``: demonstrated or not); recorded in ``record["check"]``.
+        ``evidence``: more labelled objects, as (per category its log-odds ``[m]``, labels ``[m]``), pooled
+        with the training objects (answered test objects, :meth:`score_with_answers`)."""
         from gift.core.metrics import roc_auc
 
-        aucs = np.array([roc_auc(self.log_odds(train, intent, [c] * len(train)), rel) if c is not None
-                         and rel.any() and (~rel).any() else float("nan") for c in categories])
+        extra, labels = evidence if evidence is not None else ([np.zeros(0)] * len(categories), np.zeros(0, bool))
+        labels = np.asarray(labels, dtype=bool)
+        pos, neg = rel.any() or labels.any(), (~rel).any() or (~labels).any()
+        aucs = np.array([roc_auc(np.concatenate([self.log_odds(train, intent, [c] * len(train)), x]),
+                                 np.concatenate([rel, labels])) if c is not None and pos and neg
+                         else float("nan") for c, x in zip(categories, extra)])
         known = ~np.isnan(aucs)
         weights = np.ones(len(categories))
         if known.any():
@@ -722,10 +745,14 @@ class GiftProbKernel(RelevanceKernel):
         return mask
 
     def _embed_scores(self, objs: Sequence[ObjectSpec], train: Sequence[ObjectSpec], rel: np.ndarray,
-                      exclude_self: bool) -> np.ndarray:
-        """Description similarity of each object to the relevant training objects (``[n]``)."""
+                      exclude_self: bool | np.ndarray) -> np.ndarray:
+        """Description similarity of each object to the relevant training objects (``[n]``), less (contrastive)
+        that to the others. ``exclude_self``: True when ``objs`` is ``train`` (each object's own pair left out),
+        or a bool mask ``[n, n_train]`` of the pairs left out."""
         sim = np.asarray(self.language.similarity(list(objs), list(train)), dtype=float)
-        if exclude_self:
+        if isinstance(exclude_self, np.ndarray):
+            sim[exclude_self] = np.nan
+        elif exclude_self:
             np.fill_diagonal(sim, np.nan)
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows (no partner left) become 0 below
@@ -844,7 +871,8 @@ class GiftProbKernel(RelevanceKernel):
 
     def score_with_answers(self, test: Sequence[ObjectSpec], train: Sequence[ObjectSpec], intent: Intent | None,
                            relevant_train: Sequence[str], answers: Mapping[str, bool]) -> RelevanceScores | None:
-        """The scene scored again with the human's answers (rule 5 of :mod:`gift.core.queries`): the category
+        """The scene scored again with the human's answers (rule 5 of :mod:`gift.core.queries`). With
+        ``rescore_with="evidence"``: :meth:`_rescore_with_evidence` (no LM call). With ``"ladder"``: the category
         ladder is named again with the test objects answered "yes" beside the demonstrated ones and those
         answered "no" beside the left-alone ones, every object is asked about the new rungs, and the LM term
         is the mean of the z-scored log-odds under the goal's category (unchanged) and the new rungs; then
@@ -860,6 +888,8 @@ class GiftProbKernel(RelevanceKernel):
         if unknown:
             raise GiftError(f"gift-prob: answers about {unknown}, which are not test objects {names}")
         base = self.score(test, train, intent, relevant_train)  # every LM answer of it is memoized
+        if self.rescore_with == "evidence":
+            return self._rescore_with_evidence(test, train, intent, base, answers) if answers else None
         lad = base.details.get("ladder")
         if lad is None or not answers:
             return None
@@ -882,6 +912,49 @@ class GiftProbKernel(RelevanceKernel):
                              "categories_before": list(lad["categories"])}
         lo = self._mix_views(train, intent, rel, [goal, *terms], [details.get("category"), *rungs], details["ladder"])
         return self._finish(test, train, rel, lo, details)
+
+    def _rescore_with_evidence(self, test: list[ObjectSpec], train: list[ObjectSpec], intent: Intent,
+                               base: RelevanceScores, answers: Mapping[str, bool]) -> RelevanceScores | None:
+        """:meth:`score_with_answers` with ``rescore_with="evidence"``: no new LM question. The answered test
+        objects are labelled evidence beside the training objects ("yes" with the demonstrated ones, "no"
+        with the left-alone ones) in the check of the ladder's categories (:meth:`_check_weights`, with their
+        log-odds under each category), as references of the MiniLM term (an object is not its own reference)
+        and in the terms' reliability weights; then the terms are combined as in :meth:`score`. None (answers
+        only re-threshold) with a calibration, or with neither the MiniLM term nor the ladder to re-weigh."""
+        lad = base.details.get("ladder")
+        if self.calibration is not None or (self.combine == "none" and lad is None):
+            return None
+        names = [o.name for o in test]
+        idx = np.array([i for i, n in enumerate(names) if answers.get(n) is not None], dtype=int)
+        labels = np.array([bool(answers[names[i]]) for i in idx], dtype=bool)
+        rel = np.asarray(base.relevant, dtype=bool)
+        n_test = len(test)
+        details: dict[str, Any] = {k: v for k, v in base.details.items() if k in ("category", "goal")}
+        details["evidence"] = {"yes": [names[i] for i in idx[labels]], "no": [names[i] for i in idx[~labels]]}
+        terms = base.details["terms"]["lm"]
+        lo = np.asarray(terms["test"] + terms["train"], dtype=float)
+        if lad is not None:
+            views = [np.asarray(lad["goal"], dtype=float)] + [np.asarray(t["test"] + t["train"], dtype=float)
+                                                               for t in lad["terms"]]
+            details["ladder"] = {k: lad[k] for k in ("categories", "goal", "terms")}
+            lo = self._mix_views(train, intent, rel, views, [details.get("category"), *lad["categories"]],
+                                 details["ladder"], evidence=(idx, labels))
+        details["terms"] = {"lm": {"test": lo[:n_test].tolist(), "train": lo[n_test:].tolist()}}
+        if self.combine == "none":
+            return RelevanceScores(_sigmoid(lo[:n_test]), _sigmoid(lo[n_test:]), rel, details, **self._prior())
+        refs = list(train) + [test[i] for i in idx]
+        ref_rel = np.concatenate([rel, labels])
+        own_test = np.zeros((n_test, len(refs)), dtype=bool)
+        own_test[idx, len(train) + np.arange(len(idx))] = True
+        own_train = np.zeros((len(train), len(refs)), dtype=bool)
+        own_train[np.arange(len(train)), np.arange(len(train))] = True
+        emb = np.concatenate([self._embed_scores(test, refs, ref_rel, own_test) if test else np.zeros(0),
+                              self._embed_scores(train, refs, ref_rel, own_train)])
+        details["terms"]["language"] = {"test": emb[:n_test].tolist(), "train": emb[n_test:].tolist()}
+        z, details["weights"] = self._combine(lo, emb, rel, n_test, evidence=(idx, labels))
+        if "ladder" in details:
+            self._ladder_views(details, emb, rel, n_test)
+        return RelevanceScores(_sigmoid(z[:n_test]), _sigmoid(z[n_test:]), rel, details, **self._prior())
 
     def _finish(self, test: list[ObjectSpec], train: list[ObjectSpec], rel: np.ndarray, lo: np.ndarray,
                 details: dict[str, Any]) -> RelevanceScores:
@@ -907,15 +980,18 @@ class GiftProbKernel(RelevanceKernel):
             self._ladder_views(details, emb, rel, len(test))
         return RelevanceScores(_sigmoid(z[: len(test)]), _sigmoid(z[len(test):]), rel, details, **self._prior())
 
-    def _combine(self, lo: np.ndarray, emb: np.ndarray, rel: np.ndarray, n_test: int
-                 ) -> tuple[np.ndarray, dict[str, float]]:
+    def _combine(self, lo: np.ndarray, emb: np.ndarray, rel: np.ndarray, n_test: int,
+                 evidence: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, dict[str, float]]:
         """The combined z-score ``[n_test + n_train]`` of the LM log-odds ``lo`` and the MiniLM term ``emb``
-        (test objects first), and the weight of each term."""
+        (test objects first), and the weight of each term. ``evidence``: (indices of labelled test objects,
+        their labels), weighed beside the training objects in the reliability weights."""
         ref = slice(None) if self.standardize == "pooled" else slice(n_test, None)
         terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
         w = {"lm": 1.0 - self.weight, "language": self.weight}
         if self.weighting == "reliability":
-            sep = {t: separation_weight(v[n_test:], rel) for t, v in terms.items()}
+            idx, labels = evidence if evidence is not None else (np.zeros(0, int), np.zeros(0, bool))
+            sep = {t: separation_weight(np.concatenate([v[n_test:], v[idx]]), np.concatenate([rel, labels]))
+                   for t, v in terms.items()}
             scaled = {t: w[t] * sep[t] for t in terms}
             if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
                 w = scaled
