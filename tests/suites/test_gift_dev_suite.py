@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9`` and ``gift-dev10``: new intents and objects, none
-borrowed from the suites they are checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10`` and ``gift-dev11``: new intents and
+objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -119,6 +119,18 @@ DEV_SUITES = {
                        r"|\biron(?:s|ed|ing)?\b|\bcreas(?:e|es|ed|ing)\b|\bwrinkl"
                        r"|\bbowls?\b|\blawn\b|\bjacks?\b|\bbowling\b|\bbowlers?\b"
                        r"|\bhinge|\bbook|\bends?\b",
+    },
+    "gift-dev11": {
+        "siblings": [("lampshades", "tomato_things"), ("squashes", "cranked_things"),
+                     ("rugby_kit", "ice_skating_kit"), ("aprons", "suction_cup_things")],
+        "label_words": r"lampshade|\bshades?\b|\blamps?\b"
+                       r"|tomato|passata|ketchup|gazpacho|pomodoro|\bsugo\b"
+                       r"|squash|pumpkin|courgette|zucchin|\bmarrows?\b|\bgourds?\b|cucurbit|kabocha|patty.?pan"
+                       r"|butternut|\bcrank"
+                       r"|rugby|\bscrums?\b|\bline-?out"
+                       r"|\bskat|\bice\b|\brinks?\b"
+                       r"|\baprons?\b|\bpinn(?:y|ies)\b|\bpinafores?\b|tablier|maekake"
+                       r"|suction|\bsuckers?\b|\bplungers?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
