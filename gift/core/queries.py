@@ -714,12 +714,12 @@ def align_with_queries(kernel: SimilarityKernel, test: Sequence[ObjectSpec], tra
                        threshold: str | float = "train-calibrated", abstain: float = 0.0,
                        trajectories: Sequence[FeatureBatch] = (),
                        candidates: Mapping[str, AlignmentScores] | None = None,
-                       answers: Sequence[Answer] = (), seed: int = 0, rescore: bool = False) -> QueryState:
+                       answers: Sequence[Answer] = (), seed: int = 0, rescore: bool = True) -> QueryState:
     """Score a scene once with ``kernel``, then ask the human up to ``n`` questions through ``answer``.
 
-    ``rescore``: let the kernel score the scene again with the answers when it can (rule 5; each answer
-    then costs kernel calls); False (the default, see docs/results/queries-rescore.md): answers only
-    re-threshold the first scores.
+    ``rescore``: let the kernel score the scene again with the answers when it can (rule 5; the default since
+    2026-12-04, docs/results/queries.md: ``gift-prob`` then weighs the answers as evidence, no LM call); False:
+    answers only re-threshold the first scores.
 
     ``answer(object name) -> bool | str | None`` is the human (see :func:`parse_reply`); the result's
     ``alignment`` is f_ω after the answers, ``abstained`` the flagged objects. Example::

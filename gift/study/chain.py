@@ -98,8 +98,8 @@ class StudyConfig:
     human (the suite's labels) answers, chosen by the registered ``query_policy``; ``abstain``: the
     abstention band around the cut (:mod:`gift.core.queries`); with either, each kernel gets a second row
     (:func:`query_label`) in RQ1 and RQ2. ``query_rescore``: a kernel that can use the answers scores the
-    scene again with them (rule 5 of :mod:`gift.core.queries`; LM calls); off by default (measured in
-    docs/results/queries-rescore.md: not better on every development suite), answers then only re-threshold.
+    scene again with them (rule 5 of :mod:`gift.core.queries`; on by default since 2026-12-04: ``gift-prob``
+    weighs them as evidence without LM calls, docs/results/queries.md); off: answers only re-threshold.
     """
 
     suite: str = "gift-paper"
@@ -129,7 +129,7 @@ class StudyConfig:
     queries: int = attrs.field(default=0, validator=_non_negative)
     query_policy: str = "uncertainty"
     abstain: float = attrs.field(default=0.0, validator=_band)
-    query_rescore: bool = False
+    query_rescore: bool = True
 
     def key(self) -> str:
         """A short hash of the configuration (names the run in the manifest)."""

@@ -503,7 +503,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
                        executor: Executor | str | None = None, echo: bool = False,
                        stages: str | Path | None = None, config: StudyConfig | None = None,
                        queries: int = 0, query_policy: str = "uncertainty", abstain: float = 0.0,
-                       query_rescore: bool = False) -> dict[str, Any]:
+                       query_rescore: bool = True) -> dict[str, Any]:
     """Evaluate kernels (registered names, optionally ``name:key=value``) on a suite; returns a JSON-able dict.
 
     The work is one :class:`AlignItem` per (kernel, intent) on ``executor`` (None: ``serial``); with
@@ -515,7 +515,7 @@ def evaluate_alignment(suite: Suite | str, kernels: Sequence[str], *, thresholds
     inferred intents. ``config``: the study sizes for the demonstrations (default :class:`StudyConfig`).
     ``queries`` / ``query_policy`` / ``abstain``: questions per kernel and intent answered from the suite's
     labels, and the abstention band (:func:`~gift.study.chain.query_stage`); results under ``queries``;
-    ``query_rescore``: the kernel scores the scene again with the answers when it can (rule 5).
+    ``query_rescore``: the kernel scores the scene again with the answers when it can (rule 5; the default).
     """
     started, t0, source = time.time(), time.perf_counter(), source_at_start()
     if isinstance(suite, str):

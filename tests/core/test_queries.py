@@ -440,14 +440,14 @@ def test_rule_5_a_kernel_that_uses_answers_re_scores_the_scene_once_per_set_of_a
     assert what_if.rescored and k.calls == [{"x": True}]
     # "don't know" is no evidence: no re-scoring
     assert not resolve(p, [Answer("y", None)]).rescored and k.calls == [{"x": True}]
-    # the session driver: with rescore=True every real answer re-scores; by default answers only re-threshold
-    k.calls.clear()
-    st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
-                            n=2, policy="uncertainty", rescore=True)
-    assert st.rescored and len(k.calls) == 2 and len(k.calls[1]) == 2
+    # the session driver: by default every real answer re-scores; with rescore=False answers only re-threshold
     k.calls.clear()
     st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
                             n=2, policy="uncertainty")
+    assert st.rescored and len(k.calls) == 2 and len(k.calls[1]) == 2
+    k.calls.clear()
+    st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
+                            n=2, policy="uncertainty", rescore=False)
     assert not st.rescored and k.calls == []
 
 

@@ -248,8 +248,9 @@ def test_a_kernel_that_re_scores_with_the_answers_shows_its_new_ladder(tmp_path)
                              relevant_train=spec.relevant_train)
     cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
                       thresholds=("train-calibrated",))
-    assert rescorer(cfg, suite, spec, kernel, None, spec.relevant_train) is None  # off by default
-    cfg = attrs.evolve(cfg, query_rescore=True)
+    assert cfg.query_rescore is True  # on by default
+    off = attrs.evolve(cfg, query_rescore=False)
+    assert rescorer(off, suite, spec, kernel, None, spec.relevant_train) is None
     q = query_stage(cfg, spec, scores, rescore=rescorer(cfg, suite, spec, kernel, None, spec.relevant_train))
     assert q["rescored"] is True and q["rescored_ladder"] == ["jewelry", "small valuables"]
     assert [len(a) for a in kernel.answers] == [1, 2]  # once per answer

@@ -813,7 +813,7 @@ def test_gift_prob_answers_re_weigh_the_re_named_rungs_by_the_same_check():
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
     inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
-    k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit")
+    k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit", rescore_with="ladder")
     rs = k.score_with_answers(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"), {"crayons": True})
     lad = rs.details["ladder"]
     assert lad["categories"] == ["coloring tools", "art supplies"]
@@ -900,4 +900,4 @@ def test_gift_prob_answers_as_evidence_are_references_of_the_minilm_term_and_wei
         sep[t] = max(roc_auc(np.concatenate([z[3:], z[[0, 1]]]), lab) - 0.5, 0.0) * 0.5
     assert rs.details["weights"] == pytest.approx({t: sep[t] / sum(sep.values()) for t in sep})
     assert rs.details["evidence"] == {"yes": ["crayons"], "no": ["toothbrush"]}
-    assert GiftProbKernel().rescore_with == "ladder"  # the default
+    assert GiftProbKernel().rescore_with == "evidence"  # the default (docs/results/queries.md, gift-dev10)

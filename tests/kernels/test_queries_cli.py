@@ -92,14 +92,14 @@ def test_evaluate_alignment_with_queries_answered_from_the_suite_labels(tmp_path
     assert "| language | train-calibrated +2q uncertainty abstain 0.01 (" in table
     res = json.loads(out.read_text())
     assert res["queries"] == {"n": 2, "policy": "uncertainty", "abstain": 0.01, "threshold": "train-calibrated",
-                              "rescore": False, "move": "stay", "choose": "primary"}
+                              "rescore": True, "move": "stay", "choose": "primary"}
     suite = load_suite(SUITE)
     k = res["kernels"]["language"]
     for spec in suite.intents:
         q = k["intents"][spec.id]["queries"]
         labels = {t.object: t.relevant for t in spec.test}
         assert q["asked"] == 2 and q["threshold"] == "train-calibrated"
-        assert q["rescored"] is False  # answers only re-threshold by default
+        assert q["rescored"] is False  # re-scoring is the default, but the MiniLM kernel cannot use answers
         for a in q["answers"]:  # the simulated human answered from the labels; the answers are kept
             assert a["relevant"] == labels[a["object"]] and q["predicted"][a["object"]] == a["relevant"]
         m = q["metrics"]["train-calibrated"]["all"]

@@ -21,6 +21,7 @@ pytestmark = [pytest.mark.slow, pytest.mark.lm]
 
 SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
 TEST = ["colored pencils", "crayons", "toothbrush", "apple", "paint roller", "hairbrush"]
+KSPEC = "gift-prob:ladder=always:rescore_with=ladder"
 
 
 @pytest.fixture(scope="module")
@@ -111,7 +112,7 @@ def test_a_python_callback_on_the_real_kernel_without_new_lm_questions(scene):
     assert all(abs(scores.decision[TEST.index(t)] - st.cut) < 0.02 for t in st.abstained)
 
 
-def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
+def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene, monkeypatch):
     """Rule 5 on the real kernel: with the ladder on (an inferred intent), each answer names the ladder again
     with the answered objects and every object is asked about the new rungs."""
     from gift_kernels.lm_kernels import _zscore
@@ -120,6 +121,7 @@ def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
     inferred = Intent(text=spec.text, source="inferred")  # gift-prob's ladder is on for inferred intents
     first = score_alignment(kernel, test, train, inferred, relevant_train=spec.relevant_train)
     assert first.details["ladder"]["categories"]
+    monkeypatch.setattr(kernel, "rescore_with", "ladder")  # the default is "evidence" (the next test)
     rescore = kernel_rescorer(kernel, test, train, inferred, relevant_train=spec.relevant_train)
     calls = kernel.calls
     states = list(asking(QueryProblem.of(first, rescore=rescore), "uncertainty", labels_answerer(labels), 2))
@@ -149,7 +151,7 @@ def test_answers_re_name_the_real_ladder_and_re_score_the_scene(scene):
     assert kernel.calls == calls and np.array_equal(again.predicted, after.predicted)
 
 
-def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene, monkeypatch):
+def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene):
     """rescore_with="evidence" on the real kernel (an inferred intent: the ladder and MiniLM on): the answers
     re-weigh the ladder's categories and the MiniLM references with no new LM question; the check's AUCs are
     the training objects' in-sample log-odds pooled with the answered objects', and no object is its own
@@ -159,7 +161,7 @@ def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene
     kernel, test, train, _, spec, _, labels = scene
     inferred = Intent(text=spec.text, source="inferred")
     first = score_alignment(kernel, test, train, inferred, relevant_train=spec.relevant_train)
-    monkeypatch.setattr(kernel, "rescore_with", "evidence")
+    assert kernel.rescore_with == "evidence"  # the default
     rescore = kernel_rescorer(kernel, test, train, inferred, relevant_train=spec.relevant_train)
     calls = kernel.calls
     states = list(asking(QueryProblem.of(first, rescore=rescore), "uncertainty", labels_answerer(labels), 2))
@@ -196,21 +198,22 @@ def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene
 
 
 def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_not_to(tmp_path, capsys):
-    """``gift evaluate-alignment --queries 1`` on one intent with gift-prob's ladder on: the answer re-names the
-    ladder (rule 5) with ``--rescore``; without it, the session only re-thresholds the same first scores."""
+    """``gift evaluate-alignment --queries 1`` on one intent with gift-prob's ladder on and
+    ``rescore_with=ladder``: the answer re-names the ladder (rule 5; re-scoring is the default); with
+    ``--no-rescore`` the session only re-thresholds the same first scores."""
     from gift.cli import main
 
     runs = {}
-    for flag in (["--rescore"], []):
-        out = tmp_path / f"res{len(flag)}.json"  # res1: --rescore, res0: without
-        assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", "gift-prob:ladder=always", "--intents",
+    for flag in ([], ["--no-rescore"]):
+        out = tmp_path / f"res{len(flag)}.json"  # res0: re-scoring (the default), res1: --no-rescore
+        assert main(["evaluate-alignment", "--suite", SUITE, "--kernels", KSPEC, "--intents",
                      "art_supplies", "--threshold", "train-calibrated", "--queries", "1", "--out", str(out),
                      "--executor", "serial", "-q"] + flag) == 0
-        runs[bool(flag)] = json.loads(out.read_text())
+        runs[not flag] = json.loads(out.read_text())
     on, off = runs[True], runs[False]
     assert on["queries"]["rescore"] is True and off["queries"]["rescore"] is False
-    q_on = on["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]
-    q_off = off["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["queries"]
+    q_on = on["kernels"][KSPEC]["intents"]["art_supplies"]["queries"]
+    q_off = off["kernels"][KSPEC]["intents"]["art_supplies"]["queries"]
     assert q_on["rescored"] is True and q_off["rescored"] is False
     assert q_on["rescored_ladder"] and q_off["rescored_ladder"] == []
     assert q_on["answers"] == q_off["answers"]  # the same first question, from the same first scores
@@ -221,7 +224,7 @@ def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_no
     from gift.core.alignment import AlignmentScores
     from gift.study.scenes import stable_seed
 
-    scores = AlignmentScores.from_dict(off["kernels"]["gift-prob:ladder=always"]["intents"]["art_supplies"]["scores"])
+    scores = AlignmentScores.from_dict(off["kernels"][KSPEC]["intents"]["art_supplies"]["scores"])
     st = ask(QueryProblem.of(scores, "train-calibrated"), "uncertainty", labels_answerer(labels), 1,
              seed=stable_seed("queries", "art_supplies"))
     assert st.to_dict()["predicted"] == q_off["predicted"]

@@ -65,9 +65,10 @@ def add_query_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects whose decision score is within BAND of the cut; "
                         "their features are dropped like a distractor's (default 0: never)")
-    p.add_argument("--rescore", action="store_true",
-                   help="a kernel that can use the answers (gift-prob with its category ladder) scores the scene "
-                        "again after each answer (LM calls); default: answers only re-threshold the first scores")
+    p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
+                   help="a kernel that can use the answers scores the scene again after each answer (the default; "
+                        "gift-prob weighs them as evidence, no LM call, or with gift-prob:rescore_with=ladder names "
+                        "its ladder again); --no-rescore: answers only re-threshold the first scores")
 
 
 def _check_queries(args: argparse.Namespace) -> None:

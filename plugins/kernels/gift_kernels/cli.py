@@ -48,10 +48,10 @@ def configure_align(p: argparse.ArgumentParser) -> None:
                    help="which objects to ask about: uncertainty (default), disagreement, error-bound, random")
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects within BAND of the cut (dropped like a distractor)")
-    p.add_argument("--rescore", action="store_true",
-                   help="a kernel that can use the answers (gift-prob with its category ladder on, e.g. --kernel "
-                        "gift-prob:ladder=always) scores the scene again after each answer; default: answers only "
-                        "re-threshold the first scores")
+    p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
+                   help="a kernel that can use the answers scores the scene again after each answer (the default; "
+                        "gift-prob weighs them as evidence, no LM call); --no-rescore: answers only re-threshold "
+                        "the first scores")
     p.add_argument("--answers", default=None, metavar="FILE",
                    help="where --ask saves and finds answers (default: answers.json in the gift cache directory)")
 

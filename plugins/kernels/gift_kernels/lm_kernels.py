@@ -310,8 +310,8 @@ class GiftProbKernel(RelevanceKernel):
     (``"fit"``, the default: each of the ladder's categories is first asked of the training objects as named and
     kept only if it puts every demonstrated object above every left-alone one; ``"weight"``: weighted by its
     AUC - 1/2 there; ``"none"``: all averaged as they are), ``rescore_with`` (what the human's answers do when the
-    scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"``, the default, names the ladder again with
-    them; ``"evidence"`` asks the LM nothing new and counts them beside the training objects). The defaults were chosen on the development suites,
+    scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"`` names the ladder again with
+    them; ``"evidence"``, the default, asks the LM nothing new and counts them beside the training objects). The defaults were chosen on the development suites,
     docs/results/front_half.md (sections 10-14).
     """
 
@@ -325,7 +325,7 @@ class GiftProbKernel(RelevanceKernel):
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
-                 embed_text: str = "description", ask_text: str = "both", rescore_with: str = "ladder") -> None:
+                 embed_text: str = "description", ask_text: str = "both", rescore_with: str = "evidence") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -350,10 +350,12 @@ class GiftProbKernel(RelevanceKernel):
         self.ask_text = ask_text
         if rescore_with not in RESCORE_WITH:
             raise GiftError(f"gift-prob: rescore_with must be one of {RESCORE_WITH}, got {rescore_with!r}")
-        #: What answers do when the scene is re-scored with them (:meth:`score_with_answers`; only when the
-        #: caller re-scores, e.g. ``--rescore``): ``"ladder"`` (the ladder named again with them, LM calls) or
-        #: ``"evidence"`` (no LM call: the answered test objects join the training objects as labelled
-        #: evidence in the check of the categories, the MiniLM term's references and the terms' weights).
+        #: What answers do when the scene is re-scored with them (:meth:`score_with_answers`; callers re-score
+        #: by default, ``--no-rescore`` turns it off): ``"evidence"`` (the default: no LM call; the answered
+        #: test objects join the training objects as labelled evidence in the check of the categories, the
+        #: MiniLM term's references and the terms' weights) or ``"ladder"`` (the ladder named again with them,
+        #: LM calls). "evidence" was chosen on gift-dev10 by a rule written before it was run (pooled F1 after
+        #: 2 questions, mean over both intent sources, 0.882 -> 0.908; docs/results/queries.md).
         self.rescore_with = rescore_with
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
