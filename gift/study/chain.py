@@ -374,7 +374,10 @@ def query_stage(cfg: StudyConfig, spec: IntentSpec, scores: AlignmentScores,
                               rescore=rescore if cfg.query_rescore else None)
     state = ask(problem, cfg.query_policy, labels_answerer(labels), cfg.queries, seed=stable_seed("queries", spec.id))
     metrics = alignment_metrics(state.decision, [t.relevant for t in spec.test], subset_masks(spec), {th: state.cut})
-    ladder = (state.scores.details.get("ladder") or {}) if state.rescored else {}
+    # the ladder named again with the answers (gift-prob's rescore_with="ladder"); answers weighed as evidence
+    # keep the first ladder, so none is reported
+    renamed = state.rescored and "evidence" not in state.scores.details
+    ladder = (state.scores.details.get("ladder") or {}) if renamed else {}
     return {"policy": cfg.query_policy, "queries": cfg.queries, "abstain": cfg.abstain, "threshold": th,
             **state.to_dict(), "rescored_ladder": list(ladder.get("categories") or []), "metrics": metrics}
 

@@ -260,6 +260,44 @@ def test_a_kernel_that_re_scores_with_the_answers_shows_its_new_ladder(tmp_path)
     assert "re-scored with the answers; ladder named again: jewelry &gt; small valuables" in page
 
 
+def test_answers_weighed_as_evidence_report_a_re_scoring_but_no_new_ladder(tmp_path):
+    """gift-prob's default re-scoring (``rescore_with="evidence"``) keeps its first ladder: the record names no
+    re-named ladder and report.html says only that the scene was re-scored."""
+    from gift.core.alignment import score_alignment
+    from gift.core.data import RelevanceScores
+    from gift.core.interfaces import RelevanceKernel
+    from gift.core.serialization import to_jsonable
+    from gift.study.chain import StudyConfig, query_stage, rescorer
+
+    class Evidence(RelevanceKernel):
+        name = "evidence"
+
+        def score(self, test, train, intent=None, relevant_train=()):
+            return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
+                                   [0.8 if o.name in relevant_train else 0.2 for o in train],
+                                   [o.name in relevant_train for o in train])
+
+        def score_with_answers(self, test, train, intent, relevant_train, answers):
+            first = self.score(test, train, intent, relevant_train)
+            return RelevanceScores(first.relevance[::-1], first.train_loo, first.relevant,
+                                   {"ladder": {"categories": ["jewelry"]}, "evidence": {"yes": [], "no": []}})
+
+    suite = gift.load_suite(str(MINI))
+    spec = suite.intent("valuables")
+    kernel = Evidence()
+    scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+                             relevant_train=spec.relevant_train)
+    cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
+                      thresholds=("train-calibrated",))
+    q = query_stage(cfg, spec, scores, rescore=rescorer(cfg, suite, spec, kernel, None, spec.relevant_train))
+    assert q["rescored"] is True and q["rescored_ladder"] == []
+    results = results_with_queries()
+    results["alignment"]["valuables"]["language"]["queries"] = to_jsonable(q, nonfinite="null")
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert '<small class="rescored">re-scored with the answers</small>' in page
+    assert "ladder named again" not in page
+
+
 def test_no_questions_no_section(tmp_path):
     results = results_with_queries()
     del results["alignment"]["valuables"]["language"]["queries"]

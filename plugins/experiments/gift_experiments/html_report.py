@@ -631,6 +631,8 @@ class Report:
             if q.get("rescored_ladder"):
                 asked += (f'<small class="rescored">re-scored with the answers; ladder named again: '
                           f'{esc(" > ".join(q["rescored_ladder"]))}</small>')
+            elif q.get("rescored"):
+                asked += '<small class="rescored">re-scored with the answers</small>'
             ab = q.get("abstained") or []
             ba = self._before_after(intent, kernel, row, q)
             out.append(f'<tr class="query-row" data-intent="{esc(intent)}" data-kernel="{esc(kernel)}">'
