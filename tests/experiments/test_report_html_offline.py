@@ -152,26 +152,44 @@ def test_undefined_numbers_of_strict_json_show_as_missing(tmp_path):
 MINI = ROOT / "tests" / "kernels" / "data" / "mini_suite.yaml"
 
 
-def results_with_queries() -> dict:
-    """A study of one intent of the mini suite whose ``language`` row asked the simulated human 2 questions
-    (:func:`gift.study.chain.query_stage` on fixed kernel scores; no kernel, no LM, no Drake)."""
-    from gift.core.alignment import score_alignment
+def fixed_kernel(rescored_details=None):
+    """Scripted relevance kernel with fixed scores; with ``rescored_details`` it also re-scores with answers
+    (the scores reversed, those details attached) and records each set of answers in ``.answers``."""
     from gift.core.data import RelevanceScores
     from gift.core.interfaces import RelevanceKernel
-    from gift.core.serialization import to_jsonable
-    from gift.study.chain import StudyConfig, query_label, query_stage
 
     class Fixed(RelevanceKernel):
         name = "fixed"
+
+        def __init__(self):
+            self.answers = []
 
         def score(self, test, train, intent=None, relevant_train=()):
             return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
                                    [0.8 if o.name in relevant_train else 0.2 for o in train],
                                    [o.name in relevant_train for o in train])
 
+    class Rescoring(Fixed):
+        name = "rescoring"
+
+        def score_with_answers(self, test, train, intent, relevant_train, answers):
+            self.answers.append(dict(answers))
+            first = self.score(test, train, intent, relevant_train)
+            return RelevanceScores(first.relevance[::-1], first.train_loo, first.relevant, dict(rescored_details))
+
+    return Fixed() if rescored_details is None else Rescoring()
+
+
+def results_with_queries() -> dict:
+    """A study of one intent of the mini suite whose ``language`` row asked the simulated human 2 questions
+    (:func:`gift.study.chain.query_stage` on fixed kernel scores; no kernel, no LM, no Drake)."""
+    from gift.core.alignment import score_alignment
+    from gift.core.serialization import to_jsonable
+    from gift.study.chain import StudyConfig, query_label, query_stage
+
     suite = gift.load_suite(str(MINI))
     spec = suite.intent("valuables")
-    scores = score_alignment(Fixed(), suite.specs(spec.test_objects), suite.specs(spec.train_objects),
+    scores = score_alignment(fixed_kernel(), suite.specs(spec.test_objects), suite.specs(spec.train_objects),
                              relevant_train=spec.relevant_train)
     cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
                       thresholds=("train-calibrated",))
@@ -219,31 +237,12 @@ def test_a_kernel_that_re_scores_with_the_answers_shows_its_new_ladder(tmp_path)
     scene again (fixed tables here; the real gift-prob: tests/kernels/test_queries_lm.py), the record names the
     ladder it named again, and report.html shows it under the answers."""
     from gift.core.alignment import score_alignment
-    from gift.core.data import RelevanceScores
-    from gift.core.interfaces import RelevanceKernel
     from gift.core.serialization import to_jsonable
     from gift.study.chain import StudyConfig, query_stage, rescorer
 
-    class Rescoring(RelevanceKernel):
-        name = "rescoring"
-
-        def __init__(self):
-            self.answers = []
-
-        def score(self, test, train, intent=None, relevant_train=()):
-            return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
-                                   [0.8 if o.name in relevant_train else 0.2 for o in train],
-                                   [o.name in relevant_train for o in train])
-
-        def score_with_answers(self, test, train, intent, relevant_train, answers):
-            self.answers.append(dict(answers))
-            first = self.score(test, train, intent, relevant_train)
-            return RelevanceScores(first.relevance[::-1], first.train_loo, first.relevant,
-                                   {"ladder": {"categories": ["jewelry", "small valuables"]}})
-
     suite = gift.load_suite(str(MINI))
     spec = suite.intent("valuables")
-    kernel = Rescoring()
+    kernel = fixed_kernel({"ladder": {"categories": ["jewelry", "small valuables"]}})
     scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
                              relevant_train=spec.relevant_train)
     cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
@@ -264,27 +263,12 @@ def test_answers_weighed_as_evidence_report_a_re_scoring_but_no_new_ladder(tmp_p
     """gift-prob's default re-scoring (``rescore_with="evidence"``) keeps its first ladder: the record names no
     re-named ladder and report.html says only that the scene was re-scored."""
     from gift.core.alignment import score_alignment
-    from gift.core.data import RelevanceScores
-    from gift.core.interfaces import RelevanceKernel
     from gift.core.serialization import to_jsonable
     from gift.study.chain import StudyConfig, query_stage, rescorer
 
-    class Evidence(RelevanceKernel):
-        name = "evidence"
-
-        def score(self, test, train, intent=None, relevant_train=()):
-            return RelevanceScores([0.1 + 0.4 * (i % 3) for i in range(len(test))],
-                                   [0.8 if o.name in relevant_train else 0.2 for o in train],
-                                   [o.name in relevant_train for o in train])
-
-        def score_with_answers(self, test, train, intent, relevant_train, answers):
-            first = self.score(test, train, intent, relevant_train)
-            return RelevanceScores(first.relevance[::-1], first.train_loo, first.relevant,
-                                   {"ladder": {"categories": ["jewelry"]}, "evidence": {"yes": [], "no": []}})
-
     suite = gift.load_suite(str(MINI))
     spec = suite.intent("valuables")
-    kernel = Evidence()
+    kernel = fixed_kernel({"ladder": {"categories": ["jewelry"]}, "evidence": {"yes": [], "no": []}})
     scores = score_alignment(kernel, suite.specs(spec.test_objects), suite.specs(spec.train_objects),
                              relevant_train=spec.relevant_train)
     cfg = StudyConfig(suite=str(MINI), kernels=("language",), queries=2, query_policy="uncertainty",
