@@ -82,10 +82,11 @@ def run(args: argparse.Namespace) -> dict:
                               rescore=args.rescore, move=args.move, choose=args.choose)
             if args.rescore:  # the same sessions with answers that only re-threshold, for the comparison
                 sim["without_rescore"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
-                                                     policies=args.policies, bands=(), choose=args.choose)["curves"]
+                                                     policies=args.policies, bands=(), move=args.move,
+                                                     rescore=False, choose=args.choose)["curves"]
             else:  # the first cut rule tried (widest gap), for the record
                 sim["widest"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
-                                            policies=args.policies, bands=(), move="widest",
+                                            policies=args.policies, bands=(), move="widest", rescore=False,
                                             choose=args.choose)["curves"]
             sim.update({"suite": suite.name, "intent_source": source, "robot": args.robot, "kernel": args.kernel,
                         "config": attrs.asdict(cfg), "target": qc.target_check(sim),
@@ -193,8 +194,9 @@ def write(result: dict, md: Path) -> None:
              f"    {recipe} Inferred intents: the relevant training objects and the intent "
              "come from the demonstrations alone." + (
                  " **Answers re-score the scene** (rule 5 of `gift.core.queries`, `--rescore`): after each answer "
-                 "the kernel scores the scene again with the answers as evidence (`gift-prob` names its category "
-                 "ladder again); each suite's table also gives the same sessions without it."
+                 "the kernel scores the scene again with the answers (`gift-prob` by default weighs the answered "
+                 "objects as evidence beside the training objects, no LM call; with `rescore_with=ladder` it names "
+                 "its category ladder again); each suite's table also gives the same sessions without it."
                  if result.get("rescore") else ""), "",
              "Command:", "", "```", result["command"], "```", "",
              provenance(result) + f", LM `{lm.get('identity', '–')}` (model sha256 "
@@ -326,7 +328,11 @@ def write(result: dict, md: Path) -> None:
               "about the one `gift-prob`'s LM and MiniLM terms (or, when there are several, the intent "
               "candidates) disagree on most; *error-bound* about the one whose answer is expected to lower the "
               "paper's error bound of the scene's test trajectories most; *random* is the baseline.",
-              ("- An answer fixes its object and, here, leaves the cut where it was: only the objects asked about "
+              ("- An answer fixes its object and leaves the cut where it was; the kernel then scores the scene again "
+               "with the answers, so objects nobody asked about can move too, in either direction (each table's "
+               "\"without re-scoring\" rows: the same sessions where only the objects asked about change)."
+               if result.get("move") == "stay" and result.get("rescore") else
+               "- An answer fixes its object and, here, leaves the cut where it was: only the objects asked about "
                "change." if result.get("move") == "stay" else
                "- An answer fixes its object and moves the train-calibrated cut, so one answer can also flip "
                "objects that were not asked about, in either direction."),
@@ -365,9 +371,11 @@ def main(argv: list[str] | None = None) -> int:
                    help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
     p.add_argument("--choose", default=DEFAULT_CHOOSE, choices=CHOOSE,
                    help="which intent candidate decides after answers (rule 3 of gift.core.queries)")
-    p.add_argument("--rescore", action="store_true",
-                   help="the kernel scores each scene again with the answers (rule 5 of gift.core.queries; LM calls); "
-                        "the curves without it are kept next to them")
+    p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
+                   help="the kernel scores each scene again with the answers where it can (rule 5 of "
+                        "gift.core.queries; the default, as everywhere answers are used: gift-prob weighs them as "
+                        "evidence, no LM call; the curves without it are kept next to them); --no-rescore: answers "
+                        "only re-threshold the first scores")
     p.add_argument("--from-json", nargs="+", default=None, metavar="CURVES_JSON",
                    help="write --out from saved curves.json files (their runs merged, nothing recomputed): one page "
                         "from runs made in separate processes")

@@ -3,6 +3,7 @@ every k, random over seeds, abstention, the questions random needs, and the figu
 
 from __future__ import annotations
 
+import attrs
 import numpy as np
 import pytest
 
@@ -72,6 +73,26 @@ def test_the_ceiling_asks_the_best_two_questions_and_no_policy_gets_fewer_wrong_
             assert _wrong(best, d.labels) <= _wrong(st, d.labels)
         assert sim["curves"][policy]["f1"][k2] <= b["f1"]
     assert qc.simulate(DATA, random_seeds=1, bands=(), grid=(0, 1))["bound"] is None  # no k = 2 in the grid
+
+
+def test_scenes_are_re_scored_with_the_answers_by_default_and_only_re_thresholded_with_rescore_false():
+    """Rule 5 is on by default, as in ``align_with_queries``: a scene whose kernel can re-score is asked
+    again after each answer; ``rescore=False`` only re-thresholds; the ceiling of re-thresholding is not
+    reported for re-scored runs."""
+    asked = []
+
+    def again(answers):  # a kernel that, told anything, gets every object of intent "one" right
+        asked.append(dict(answers))
+        return intent("one", {"x": 0.9, "y": 0.1, "z": 0.9, "w": 0.1}, DATA[0].labels).scores
+
+    one = attrs.evolve(DATA[0], rescore=again)
+    sim = qc.simulate([one], random_seeds=1, bands=(), grid=(0, 1, 2))
+    assert asked and all(len(a) in (1, 2) for a in asked)
+    assert sim["curves"]["uncertainty"]["f1"] == [0.5, 1.0, 1.0] and sim["bound"] is None
+    n = len(asked)
+    plain = qc.simulate([one], random_seeds=1, bands=(), grid=(0, 1, 2), rescore=False)
+    assert len(asked) == n  # never asked again
+    assert plain["curves"]["uncertainty"]["f1"][:2] == [0.5, pytest.approx(2 / 3)] and plain["bound"]["f1"] == 1.0
 
 
 def test_questions_random_needs_are_interpolated_on_the_grid():

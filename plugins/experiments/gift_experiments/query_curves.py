@@ -101,10 +101,12 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
 
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
-            grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = False,
+            grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = True,
             choose: str = DEFAULT_CHOOSE) -> list[QueryState]:
     """The states after k questions for each k of ``grid`` (the last state when every object was asked);
-    ``rescore``: the kernel scores the scene again with the answers (rule 5; LM calls), when it can."""
+    ``rescore``: the kernel scores the scene again with the answers when it can (rule 5, the default as in
+    :func:`gift.core.queries.align_with_queries`; ``gift-prob`` weighs them as evidence, no LM call); False:
+    answers only re-threshold."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
     problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move,
                               rescore=data.rescore if rescore else None, choose=choose)
@@ -158,15 +160,15 @@ def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE,
 
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
-             bands: Sequence[float] = BANDS, move: str = DEFAULT_MOVE, rescore: bool = False,
+             bands: Sequence[float] = BANDS, move: str = DEFAULT_MOVE, rescore: bool = True,
              policies: Sequence[str] = POLICIES, choose: str = DEFAULT_CHOOSE) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
-    the kernel scores each scene again with the answers (rule 5); ``policies``: the policies run; ``choose``:
+    the kernel scores each scene again with the answers where it can (rule 5); ``policies``: the policies run; ``choose``:
     which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
-    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy), None with ``rescore``
-    or without 2 in the grid."""
+    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy when answers only
+    re-threshold), None when some scene is re-scored or without 2 in the grid."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
     for policy in tuple(policies) + (BASELINE,):
@@ -199,7 +201,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
             last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore, choose=choose)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     bound = None
-    if 2 in grid and not rescore:  # what any policy could reach with 2 questions (answers only re-threshold)
+    rescored = rescore and any(d.rescore is not None for d in data)
+    if 2 in grid and not rescored:  # what any policy could reach with 2 questions (answers only re-threshold)
         found = {d.intent: best_questions(d, 2, move, choose) for d in data}
         bound = {"k": 2, **_aggregate({i: o for i, (_, o) in found.items()}),
                  "asked": {i: [a.object for a in st.answers] for i, (st, _) in found.items()}}
