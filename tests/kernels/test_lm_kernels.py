@@ -709,6 +709,39 @@ def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_
         assert not words & goal_words, (goal, words & goal_words)
 
 
+@pytest.mark.parametrize("ladder_text", ["name", "name+description"])
+def test_gift_prob_ladder_shows_the_training_objects_descriptions_only_with_ladder_text(ladder_text):
+    """ladder_text="name+description": every ladder question (the full ladder and each leave-one-out one, both
+    kinds of rungs) shows each training object as "name (description)", the worked examples with theirs;
+    the default shows names alone, as before."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "art supplies", "middle": "drawing things", "broad": "hobby things"})
+        if messages[0].content == prompts.FACET_SYSTEM:
+            return json.dumps({"kind": "art tools", "material": "none", "property": "none"})
+        return category_json("fruit")
+
+    lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, combine="none", ladder_text=ladder_text)
+    k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
+    ladder_calls = [c[0] for c in lm.calls if c[0][0].content in (prompts.LADDER_SYSTEM, prompts.FACET_SYSTEM)]
+    assert len(ladder_calls) == 2 * (1 + len(TRAIN))  # both kinds: the full ladder and one per training object
+    described = ladder_text == "name+description"
+    for msgs in ladder_calls:
+        question = msgs[-1].content
+        assert ("paintbrush (a brush for paint)" in question) == (described and "paintbrush" in question)
+        assert ("(" in question) == described
+        assert ("coffee mug (a cup for hot drinks)" in question) == (described and "coffee mug" in question)
+        assert ("aquarium net (A small square of fine green mesh" in msgs[1].content) == described
+    full = next(m[-1].content for m in ladder_calls if "sketchbook" in m[-1].content and "paintbrush" in m[-1].content
+                and "banana" in m[-1].content)
+    assert full.startswith("Objects the person treated specially: paintbrush (a brush for paint); sketchbook (a book "
+                           "of drawing paper).\n") == described
+    with pytest.raises(GiftError, match="ladder_text"):
+        GiftProbKernel(lm=lm, ladder_text="description")
+
+
 def test_gift_prob_faceted_ladder_drops_none_and_matches_each_training_objects_rungs_by_facet():
     """rungs="facets": the LM names the kind, the material and a property the demonstrated objects share;
     "none" is no rung, and a training object's own ladder (named without it) is matched to the full one by

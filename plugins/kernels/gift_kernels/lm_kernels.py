@@ -249,6 +249,7 @@ CHECK = ("none", "fit", "weight")
 #: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
 #: as labelled evidence beside the training objects.
 RESCORE_WITH = ("ladder", "evidence")
+LADDER_TEXT = prompts.LADDER_TEXT  # how the ladder's questions show each object
 
 
 def parse_category_answer(answer: Mapping[str, Any]) -> dict[str, str]:
@@ -311,7 +312,9 @@ class GiftProbKernel(RelevanceKernel):
     kept only if it puts every demonstrated object above every left-alone one; ``"weight"``: weighted by its
     AUC - 1/2 there; ``"none"``: all averaged as they are), ``rescore_with`` (what the human's answers do when the
     scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"`` names the ladder again with
-    them; ``"evidence"``, the default, asks the LM nothing new and counts them beside the training objects). The defaults were chosen on the development suites,
+    them; ``"evidence"``, the default, asks the LM nothing new and counts them beside the training objects),
+    ``ladder_text`` (how the ladder's questions show each object: ``"name"``, the default, or
+    ``"name+description"``). The defaults were chosen on the development suites,
     docs/results/front_half.md (sections 10-14).
     """
 
@@ -325,7 +328,8 @@ class GiftProbKernel(RelevanceKernel):
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
-                 embed_text: str = "description", ask_text: str = "both", rescore_with: str = "evidence") -> None:
+                 embed_text: str = "description", ask_text: str = "both", rescore_with: str = "evidence",
+                 ladder_text: str = "name") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -357,6 +361,11 @@ class GiftProbKernel(RelevanceKernel):
         #: LM calls). "evidence" was chosen on gift-dev10 by a rule written before it was run (pooled F1 after
         #: 2 questions, mean over both intent sources, 0.882 -> 0.908; docs/results/queries.md).
         self.rescore_with = rescore_with
+        if ladder_text not in LADDER_TEXT:
+            raise GiftError(f"gift-prob: ladder_text must be one of {LADDER_TEXT}, got {ladder_text!r}")
+        #: How the ladder's questions (:meth:`ladder`) show each object: ``"name"`` (the default) or
+        #: ``"name+description"`` ("cast-iron dog (A heavy ...)"; the worked examples with descriptions too).
+        self.ladder_text = ladder_text
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
@@ -452,7 +461,8 @@ class GiftProbKernel(RelevanceKernel):
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
-                f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, rescore_with={self.rescore_with!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
+                f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, rescore_with={self.rescore_with!r}, "
+                f"ladder_text={self.ladder_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
                 f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
                 f"calibration={self.calibration_spec!r}, "
                 f"language_kernel={'default' if self._language is None else repr(self._language)})")
@@ -541,19 +551,21 @@ class GiftProbKernel(RelevanceKernel):
             self._category_memo[key] = cat
         return cat
 
-    def ladder(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> tuple[str, ...]:
+    def ladder(self, handled: Sequence[str], left_alone: Sequence[str] = (),
+               descriptions: Mapping[str, str] | None = None) -> tuple[str, ...]:
         """Names of what the ``handled`` training objects share that the ``left_alone`` ones do not: narrow to
         broad (``rungs="breadth"``) or kind, material, property (``"facets"``); one greedy call per pair of
         lists, no goal text; duplicates and "none" dropped. An answer with no usable name gives ``()``, with a
-        warning."""
-        return tuple(self._ladder_levels(handled, left_alone).values())
+        warning. ``descriptions`` (name -> description): shown beside the names when ``ladder_text`` says so."""
+        return tuple(self._ladder_levels(handled, left_alone, descriptions).values())
 
-    def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = ()) -> dict[str, str]:
+    def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = (),
+                       descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
         """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` and/or ``FACET_LEVELS``, as ``rungs`` says), levels
         without a name, or repeating an earlier level's name, left out."""
         names: dict[str, str] = {}
         for kind in self._ladder_kinds():
-            for lv, cat in self._ask_ladder(kind, handled, left_alone).items():
+            for lv, cat in self._ask_ladder(kind, handled, left_alone, descriptions).items():
                 if cat.lower() not in [n.lower() for n in names.values()]:
                     names[lv] = cat
         return names
@@ -561,9 +573,16 @@ class GiftProbKernel(RelevanceKernel):
     def _ladder_kinds(self) -> tuple[str, ...]:
         return {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets")}[self.rungs]
 
-    def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str]) -> dict[str, str]:
-        """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels."""
-        key = (kind, tuple(handled), tuple(left_alone))
+    def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str],
+                    descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
+        """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels. The objects
+        are shown with ``descriptions`` when ``ladder_text="name+description"``."""
+        if self.ladder_text == "name":
+            descriptions = None
+        else:
+            descriptions = {n: (descriptions or {}).get(n, "") for n in (*handled, *left_alone)}
+        key = (kind, tuple(handled), tuple(left_alone),
+               None if descriptions is None else tuple(descriptions.get(n, "") for n in (*handled, *left_alone)))
         with self._lock:
             if key in self._ladder_memo:
                 return self._ladder_memo[key]
@@ -572,7 +591,7 @@ class GiftProbKernel(RelevanceKernel):
         self.calls += 1
         facets = kind == "facets"
         levels = prompts.FACET_LEVELS if facets else prompts.LADDER_LEVELS
-        msgs = (prompts.facet_messages if facets else prompts.ladder_messages)(handled, left_alone)
+        msgs = (prompts.facet_messages if facets else prompts.ladder_messages)(handled, left_alone, descriptions)
         try:
             ans = ask_dict(self.lm, msgs, temperature=0.0, max_tokens=96,
                            json_schema=schemas.ladder_schema(levels) if self.constrained else None,
@@ -599,6 +618,7 @@ class GiftProbKernel(RelevanceKernel):
         goal's category) and of each rung's log-odds; a training object's rungs are named without it
         (leave-one-out; with no relevant partner left, the full ladder, as in :meth:`_categories`)."""
         handled, alone = self._split(train, rel)
+        described = {o.name: o.description for o in train}
         # every call of one kind before the other's: consecutive calls with the same system message and worked
         # examples reuse them from llama.cpp's KV cache (the answers depend on the prompt alone)
         sets = [(handled, alone)] + [([n for n in handled if n != o.name], [n for n in alone if n != o.name])
@@ -606,18 +626,18 @@ class GiftProbKernel(RelevanceKernel):
         for kind in self._ladder_kinds():
             for h, a in sets:
                 if h:
-                    self._ask_ladder(kind, h, a)
-        levels = self._ladder_levels(handled, alone)
+                    self._ask_ladder(kind, h, a, described)
+        levels = self._ladder_levels(handled, alone, described)
         full = tuple(levels.values())
         if not full:
             return lo
         loo = []  # per training object, its ladder named without it
         for h, a in sets[1:]:
             if self.rungs != "breadth":  # the same level; the full ladder's name where it names none
-                own_lv = self._ladder_levels(h, a) if h else levels
+                own_lv = self._ladder_levels(h, a, described) if h else levels
                 loo.append([own_lv.get(lv, levels[lv]) for lv in levels])
             else:  # breadth: the same position; a shorter ladder repeats its last rung
-                own = (self.ladder(h, a) if h else full) or full
+                own = (self.ladder(h, a, described) if h else full) or full
                 loo.append([own[min(r, len(own) - 1)] for r in range(len(full))])
         rungs = [self.log_odds(list(test) + list(train), intent, [name] * len(test) + [lad[r] for lad in loo])
                  for r, name in enumerate(full)]
@@ -899,7 +919,7 @@ class GiftProbKernel(RelevanceKernel):
         no = [n for n in names if answers.get(n) is False]
         rel = np.asarray(base.relevant, dtype=bool)
         handled, alone = self._split(train, rel)
-        rungs = self.ladder(handled + yes, alone + no)
+        rungs = self.ladder(handled + yes, alone + no, {o.name: o.description for o in train + test})
         if not rungs:
             return None
         goal = np.asarray(lad["goal"], dtype=float)

@@ -240,31 +240,86 @@ LADDER_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, s
 )
 
 
+#: How the ladder's questions show each object (:func:`ladder_messages`, :func:`facet_messages`): its name, or
+#: its name and its description.
+LADDER_TEXT = ("name", "name+description")
+
+#: One-sentence descriptions of the objects of :data:`LADDER_EXAMPLES` and :data:`FACET_EXAMPLES`, shown when
+#: the ladder's questions show descriptions (written for these examples; no object of any shipped suite).
+LADDER_EXAMPLE_DESCRIPTIONS: dict[str, str] = {
+    "aquarium net": "A small square of fine green mesh on a long plastic handle, for lifting fish out of a tank.",
+    "fish food flakes": "A shaker tub of dry coloured flakes sprinkled on the water of a tank at feeding time.",
+    "tripod": "Three telescoping aluminium legs with a screw mount on top that holds a camera steady.",
+    "kettle": "A stainless steel jug with a spout and a base that plugs in to boil water for tea.",
+    "car wax tin": "A flat round tin of pale paste rubbed onto paintwork with a cloth to make it shine.",
+    "windshield squeegee": "A rubber blade on a short handle, with a sponge side, for clearing a car's front window.",
+    "toaster": "A chrome box with two slots and a lever that browns slices of bread.",
+    "desk lamp": "A lamp on an adjustable arm with a weighted base, clamped to a work table.",
+    "bag of marbles": "A drawstring pouch of small glass spheres with coloured swirls inside.",
+    "box of push pins": "A little clear box of pins with round plastic heads for pinning notes to a cork board.",
+    "beach ball": "A large light ball of inflated striped vinyl.",
+    "floor cushion": "A big flat square cushion covered in thick fabric, for sitting on the floor.",
+    "party hat": "A cone of shiny card with an elastic chin strap and a paper tassel on top.",
+    "confetti cannon": "A cardboard tube that pops out a burst of paper confetti when its base is twisted.",
+    "tire gauge": "A pen-sized metal tool pressed onto a valve to read the air pressure in a tyre.",
+    "bath mat": "A soft rectangle of absorbent cotton with a rubber backing, laid beside the tub.",
+    "bamboo steamer basket": "A round woven basket with a lid, stacked over a pan of simmering water to cook dumplings.",
+    "bamboo back scratcher": "A long thin stick with a small curled hand at one end for reaching an itch.",
+    "steel colander": "A metal bowl punched with holes and with two handles, for draining boiled pasta.",
+    "plastic back massager": "A hooked rod of hard plastic with knobs for pressing on sore back muscles.",
+    "cork notice board": "A framed sheet of pressed brown bark granules hung on a wall to pin papers to.",
+    "cork yoga block": "A brick-shaped block of pressed tree bark that props up a pose on the mat.",
+    "foam yoga mat": "A long rubbery foam sheet rolled out on the floor for stretching.",
+    "glass pitcher": "A clear jug with a handle and a lip for pouring water at the table.",
+    "ice pack": "A flat sealed pouch of blue gel kept in the freezer and held against a bruise.",
+    "bag of frozen peas": "A plastic bag of small green peas, frosted over, straight from the freezer.",
+    "bread roll": "A small round loaf with a golden crust, baked that morning.",
+    "oven mitt": "A thick quilted glove for taking hot dishes out of the oven.",
+}
+
+
+def shown(name: str, description: str | None) -> str:
+    """An object as the ladder's questions show it: ``name`` or ``name (description)``."""
+    d = (description or "").strip().rstrip(".")
+    return f"{name} ({d})" if d else name
+
+
 def _ladder_question(handled: Sequence[str], left_alone: Sequence[str]) -> str:
-    return (f"Objects the person treated specially: {', '.join(handled)}.\n"
-            f"Objects they treated like any other: {', '.join(left_alone) or 'none'}.\n"
+    sep = "; " if any(s.endswith(")") for s in (*handled, *left_alone)) else ", "
+    return (f"Objects the person treated specially: {sep.join(handled)}.\n"
+            f"Objects they treated like any other: {sep.join(left_alone) or 'none'}.\n"
             "What do the specially treated objects have in common?")
 
 
-def ladder_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+def ladder_messages(handled: Sequence[str], left_alone: Sequence[str],
+                    descriptions: Mapping[str, str] | None = None) -> tuple[Message, ...]:
     """Ask for three names, narrow to broad, of what the ``handled`` training objects share that the
-    ``left_alone`` ones do not (no goal text: the question a small model answers best)."""
+    ``left_alone`` ones do not (no goal text: the question a small model answers best). ``descriptions``
+    (object name -> description): show every object, the worked examples' too, with its description."""
     return _shared_names_messages("ladder_messages", LADDER_SYSTEM, LADDER_LEVELS, LADDER_EXAMPLES, handled,
-                                  left_alone)
+                                  left_alone, descriptions)
 
 
 def _shared_names_messages(caller: str, system: str, levels: Sequence[str],
                            examples: Sequence[tuple[Sequence[str], Sequence[str], Sequence[str]]],
-                           handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+                           handled: Sequence[str], left_alone: Sequence[str],
+                           descriptions: Mapping[str, str] | None = None) -> tuple[Message, ...]:
     """A few-shot conversation asking what ``handled`` objects share that ``left_alone`` ones do not, answered
-    with one name per level (the worked ``examples`` as JSON answers)."""
+    with one name per level (the worked ``examples`` as JSON answers); with ``descriptions``, each object is
+    shown as ``name (description)`` (:func:`shown`)."""
     if not handled:
         raise ValueError(f"{caller} needs at least one handled object")
+
+    def show(names: Sequence[str], known: Mapping[str, str]) -> list[str]:
+        return list(names) if descriptions is None else [shown(n, known.get(n)) for n in names]
+
     msgs = [Message("system", system)]
     for h, a, names in examples:
-        msgs += [Message("user", _ladder_question(h, a)),
+        msgs += [Message("user", _ladder_question(show(h, LADDER_EXAMPLE_DESCRIPTIONS),
+                                                  show(a, LADDER_EXAMPLE_DESCRIPTIONS))),
                  Message("assistant", json.dumps(dict(zip(levels, names))))]
-    msgs.append(Message("user", _ladder_question(handled, left_alone)))
+    msgs.append(Message("user", _ladder_question(show(handled, descriptions or {}),
+                                                 show(left_alone, descriptions or {}))))
     return tuple(msgs)
 
 
@@ -297,11 +352,13 @@ FACET_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str, str, st
 )
 
 
-def facet_messages(handled: Sequence[str], left_alone: Sequence[str]) -> tuple[Message, ...]:
+def facet_messages(handled: Sequence[str], left_alone: Sequence[str],
+                   descriptions: Mapping[str, str] | None = None) -> tuple[Message, ...]:
     """Ask for the kind, the material and a property that the ``handled`` training objects share and the
-    ``left_alone`` ones do not, each possibly "none" (no goal text)."""
+    ``left_alone`` ones do not, each possibly "none" (no goal text); ``descriptions`` as in
+    :func:`ladder_messages`."""
     return _shared_names_messages("facet_messages", FACET_SYSTEM, FACET_LEVELS, FACET_EXAMPLES, handled,
-                                  left_alone)
+                                  left_alone, descriptions)
 
 
 _NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
