@@ -250,9 +250,12 @@ def write(result: dict, md: Path) -> None:
               *([f"- The kernel's own intent candidate decides whatever the answers say (`choose=\"primary\"`, "
                  "rule 3 of `gift.core.queries`)."] if result.get("choose") == "primary" else []),
               *([f"- Answers move the cut by `move=\"{result['move']}\"`"
-                 + (" (the default: answers never move the cut, they only fix the objects they are about)"
-                    if result["move"] == "stay" else "") + "; the first rule tried (the widest-gap midpoint) is "
-                 "in each suite's table below."] if result.get("move", "nearest") != "nearest" else []),
+                 + (" (the default: answers never move the cut" + ("; re-scoring moves the scores)" if result.get("rescore")
+                                                                   else ", they only fix the objects they are about)")
+                    if result["move"] == "stay" else "")
+                 + ("." if any("widest" not in r for r in result["runs"].values()) else
+                    "; the first rule tried (the widest-gap midpoint) is in each suite's table below.")]
+                if result.get("move", "nearest") != "nearest" else []),
               "- Win rates depend on the simulator's scenes at the commit below: the k = 0 row is `gift reproduce "
               "--kernels gift-prob` at the same commit and sizes.", ""]
     for source in sources:
