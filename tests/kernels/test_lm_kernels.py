@@ -893,6 +893,40 @@ def test_gift_prob_answers_as_evidence_drop_a_category_that_ranks_an_answered_no
         GiftProbKernel(rescore_with="again")
 
 
+def test_gift_prob_answers_as_evidence_weigh_the_ladders_views_too():
+    """After answers as evidence, the scene under each category alone (the intent candidates answers can pick)
+    is combined with the MiniLM term under the same weights as the kernel's own score: the answered objects
+    count in them."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "brush things", "middle": "art supplies", "broad": "none"})
+        return category_json("fruit")
+
+    yes = {"fruit": {"banana": 0.9, "apple": 0.9},
+           "brush things": {"paintbrush": 0.9, "sketchbook": 0.6, "toothbrush": 0.9},
+           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9}}
+    vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
+           "crayons": [0.95, 0.05, 0], "toothbrush": [0.2, 0, 0.9], "apple": [0, 1, 0.1]}
+    lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
+    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    k = GiftProbKernel(lm=lm, language_kernel=TableKernel(vec), rungs="breadth", rescore_with="evidence")
+    rel = ("paintbrush", "sketchbook")
+    k.score(TEST, TRAIN, inferred, rel)
+    rs = k.score_with_answers(TEST, TRAIN, inferred, rel, {"toothbrush": False, "crayons": True})
+    emb = np.asarray(rs.details["terms"]["language"]["test"] + rs.details["terms"]["language"]["train"])
+    relv = np.asarray(rs.relevant, dtype=bool)
+    evidence = (np.array([0, 1]), np.array([True, False]))  # crayons "yes", toothbrush "no", in test order
+    views = {c["name"]: np.asarray(c["relevance"]) for c in rs.details["candidates"]}
+    brush = rs.details["ladder"]["terms"][0]
+    lo = np.asarray(brush["test"] + brush["train"])
+    want, w = k._combine(lo, emb, relv, len(TEST), evidence=evidence)
+    assert np.allclose(views["rung 1: brush things"], 1.0 / (1.0 + np.exp(-want[: len(TEST)])))
+    without, w0 = k._combine(lo, emb, relv, len(TEST))
+    # the crayons (answered "yes") sit beside the paintbrush for MiniLM but not for the LM under "brush things":
+    # MiniLM's weight in this view rises, and the view moves
+    assert w["language"] > w0["language"] and not np.allclose(want, without)
+
+
 def test_gift_prob_answers_as_evidence_are_references_of_the_minilm_term_and_weigh_the_terms():
     """rescore_with="evidence" with the MiniLM term (true intent, no ladder): an object answered "no" is a
     reference of the left-alone side (never its own), and the answered objects count in the reliability weights."""

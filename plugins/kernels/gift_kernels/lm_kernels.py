@@ -975,7 +975,7 @@ class GiftProbKernel(RelevanceKernel):
         details["terms"]["language"] = {"test": emb[:n_test].tolist(), "train": emb[n_test:].tolist()}
         z, details["weights"] = self._combine(lo, emb, rel, n_test, evidence=(idx, labels))
         if "ladder" in details:
-            self._ladder_views(details, emb, rel, n_test)
+            self._ladder_views(details, emb, rel, n_test, evidence=(idx, labels))
         return RelevanceScores(_sigmoid(z[:n_test]), _sigmoid(z[n_test:]), rel, details, **self._prior())
 
     def _finish(self, test: list[ObjectSpec], train: list[ObjectSpec], rel: np.ndarray, lo: np.ndarray,
@@ -1021,17 +1021,19 @@ class GiftProbKernel(RelevanceKernel):
         weights = {t: v / total for t, v in w.items()}
         return sum(weights[t] * terms[t] for t in terms), weights
 
-    def _ladder_views(self, details: dict[str, Any], emb: np.ndarray, rel: np.ndarray, n_test: int) -> None:
+    def _ladder_views(self, details: dict[str, Any], emb: np.ndarray, rel: np.ndarray, n_test: int,
+                      evidence: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Report the scene under the goal's category alone and under each rung alone (each combined with
-        the MiniLM term as the kernel's own score is) as intent candidates (``details["candidates"]``, on the
-        relevance scale), so answers from the human can pick one (:mod:`gift.core.queries`, rule 3)."""
+        the MiniLM term as the kernel's own score is, the answered ``evidence`` in the weights too) as intent
+        candidates (``details["candidates"]``, on the relevance scale), so answers from the human can pick one
+        (:mod:`gift.core.queries`, rule 3)."""
         lad = details["ladder"]
         views = [("goal's category: " + str(details.get("category")), np.asarray(lad["goal"]))]
         views += [(f"rung {k + 1}: {cat}", np.asarray(t["test"] + t["train"]))
                   for k, (cat, t) in enumerate(zip(lad["categories"], lad["terms"]))]
         cands = details.setdefault("candidates", [])
         for name, lo in views:
-            z, _ = self._combine(lo, emb, rel, n_test)
+            z, _ = self._combine(lo, emb, rel, n_test, evidence=evidence)
             cands.append({"name": name, "relevance": _sigmoid(z[:n_test]).tolist(),
                           "train_loo": _sigmoid(z[n_test:]).tolist(), "chosen": False})
 
