@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10`` and ``gift-dev11``: new intents and
-objects, none borrowed from the suites they are checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11`` and ``gift-dev12``: new
+intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -131,6 +131,19 @@ DEV_SUITES = {
                        r"|\bskat|\bice\b|\brinks?\b"
                        r"|\baprons?\b|\bpinn(?:y|ies)\b|\bpinafores?\b|tablier|maekake"
                        r"|suction|\bsuckers?\b|\bplungers?\b",
+    },
+    "gift-dev12": {
+        "siblings": [("olives", "fortune_telling"), ("conifer_cones", "trigger_things"),
+                     ("ballet_kit", "juggling_kit"), ("tongs", "drawstring_things")],
+        "label_words": r"\bolives?\b|kalamata|castelvetrano|gordal"
+                       r"|fortun|\btarot|divinat|\bdiviners?\b|clairvoy|psychic|soothsay|\bseers?\b|\boracles?\b"
+                       r"|prophe|palmist|\bscry|lenormand|\brunes?\b|crystal.?balls?"
+                       r"|\bcones?\b|conifer|\bpines?\b|\bfirs?\b|spruce|larch|cedar|cypress|sequoia|redwood"
+                       r"|trigger|\bguns?\b|pistol"
+                       r"|ballet|ballerin|\bpointe\b|\btutus?\b|leotard|\bbarre\b|\bclass"
+                       r"|juggl|diabolo|\bpoi\b|devil.?sticks?|circus"
+                       r"|\btongs?\b"
+                       r"|drawstring|draw-?cords?|\bdraw(?:s|n|ing)?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
