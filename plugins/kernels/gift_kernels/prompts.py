@@ -284,8 +284,7 @@ def shown(name: str, description: str | None) -> str:
     return f"{name} ({d})" if d else name
 
 
-def _ladder_question(handled: Sequence[str], left_alone: Sequence[str]) -> str:
-    sep = "; " if any(s.endswith(")") for s in (*handled, *left_alone)) else ", "
+def _ladder_question(handled: Sequence[str], left_alone: Sequence[str], sep: str = ", ") -> str:
     return (f"Objects the person treated specially: {sep.join(handled)}.\n"
             f"Objects they treated like any other: {sep.join(left_alone) or 'none'}.\n"
             "What do the specially treated objects have in common?")
@@ -313,13 +312,14 @@ def _shared_names_messages(caller: str, system: str, levels: Sequence[str],
     def show(names: Sequence[str], known: Mapping[str, str]) -> list[str]:
         return list(names) if descriptions is None else [shown(n, known.get(n)) for n in names]
 
+    sep = ", " if descriptions is None else "; "  # descriptions have commas of their own
     msgs = [Message("system", system)]
     for h, a, names in examples:
         msgs += [Message("user", _ladder_question(show(h, LADDER_EXAMPLE_DESCRIPTIONS),
-                                                  show(a, LADDER_EXAMPLE_DESCRIPTIONS))),
+                                                  show(a, LADDER_EXAMPLE_DESCRIPTIONS), sep)),
                  Message("assistant", json.dumps(dict(zip(levels, names))))]
     msgs.append(Message("user", _ladder_question(show(handled, descriptions or {}),
-                                                 show(left_alone, descriptions or {}))))
+                                                 show(left_alone, descriptions or {}), sep)))
     return tuple(msgs)
 
 
