@@ -59,6 +59,29 @@ def category_json(category: str) -> str:
     return json.dumps({"category": category})
 
 
+def fixed_ladder(breadth: tuple[str, str, str], facets: tuple[str, str, str] | None = None, category: str = "fruit"):
+    """A scripted LM's ``answer``: every breadth ladder call names ``breadth`` (narrow, middle, broad), every facet
+    call ``facets`` (kind, material, property), every category call ``category``."""
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps(dict(zip(prompts.LADDER_LEVELS, breadth)))
+        if facets is not None and messages[0].content == prompts.FACET_SYSTEM:
+            return json.dumps(dict(zip(prompts.FACET_LEVELS, facets)))
+        return category_json(category)
+
+    return answer
+
+
+#: An intent as the 1.5B model infers it from the demonstrations: it names one object, not the class.
+PICKED_BANANA = Intent(text="The person wanted to pick up the banana.", source="inferred")
+
+#: P("yes") by category and object for the evidence tests: "brush things" fits the training objects but also
+#: says yes to the toothbrush; anything not listed gets 0.3.
+BRUSH_YES = {"fruit": {"banana": 0.9, "apple": 0.9},
+             "brush things": {"paintbrush": 0.9, "sketchbook": 0.6, "toothbrush": 0.9},
+             "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9}}
+
+
 def _names_in_order(text: str, key: str) -> list[str]:
     line = next(ln for ln in text.splitlines() if ln.startswith(key))
     return json.loads(line.split(":", 1)[1])
@@ -596,7 +619,7 @@ def test_gift_prob_ladder_averages_the_goals_category_with_rungs_named_from_the_
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.8, "crayons": 0.8}}
 
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", ladder="inferred", rungs="breadth")
     rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
     assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things"]
@@ -634,14 +657,11 @@ def test_gift_prob_asks_a_scenes_questions_object_by_object_with_the_scores_of_a
     """score() first collects the scene's yes/no questions (no LM call for them), then asks them grouped by
     object: each question carries a cut hint ending before its category, and the questions sharing the text
     before it are asked one after another, each once. The scores are those of asking category by category."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
-        return category_json("fruit")
+    answer = fixed_ladder(("painting tools", "art supplies", "creative things"))
 
     yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.8},
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.8}}
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
 
     def run(by_object: bool):
         lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
@@ -714,15 +734,10 @@ def test_gift_prob_ladder_shows_the_training_objects_descriptions_only_with_ladd
     """ladder_text="name+description": every ladder question (the full ladder and each leave-one-out one, both
     kinds of rungs) shows each training object as "name (description)", the worked examples with theirs;
     the default shows names alone, as before."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "art supplies", "middle": "drawing things", "broad": "hobby things"})
-        if messages[0].content == prompts.FACET_SYSTEM:
-            return json.dumps({"kind": "art tools", "material": "none", "property": "none"})
-        return category_json("fruit")
+    answer = fixed_ladder(("art supplies", "drawing things", "hobby things"), ("art tools", "none", "none"))
 
     lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", ladder_text=ladder_text)
     k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
     ladder_calls = [c[0] for c in lm.calls if c[0][0].content in (prompts.LADDER_SYSTEM, prompts.FACET_SYSTEM)]
@@ -755,7 +770,7 @@ def test_gift_prob_faceted_ladder_drops_none_and_matches_each_training_objects_r
         return category_json("fruit")
 
     lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", rungs="facets")
     rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
     assert rs.details["ladder"]["categories"] == ["art supplies", "things that stain"]
@@ -775,15 +790,11 @@ def test_gift_prob_faceted_ladder_drops_none_and_matches_each_training_objects_r
 
 def test_gift_prob_both_ladders_average_the_breadth_and_the_facet_rungs_without_repeats():
     """rungs="both": one breadth and one facet call per ladder; their rungs, a name given twice once."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
-        if messages[0].content == prompts.FACET_SYSTEM:
-            return json.dumps({"kind": "Art supplies", "material": "none", "property": "things that stain"})
-        return category_json("fruit")
+    answer = fixed_ladder(("painting tools", "art supplies", "creative things"),
+                          ("Art supplies", "none", "things that stain"))
 
     lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", rungs="both")
     rs = k.score(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"))
     assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things",
@@ -799,17 +810,14 @@ def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_o
     (in-sample); a category whose answers invert the demonstrated objects (the goal's "fruit") gets no weight,
     "fit" keeps only the categories that put every demonstrated object above every left-alone one, "weight"
     weighs each by AUC - 1/2. The LM term is the weighted mean of the z-scored log-odds."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "painting tools", "middle": "art supplies", "broad": "creative things"})
-        return category_json("fruit")
+    answer = fixed_ladder(("painting tools", "art supplies", "creative things"))
 
     yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "painting tools": {"paintbrush": 0.9},
            "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
 
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     rs = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check=check).score(TEST, TRAIN, inferred,
                                                                                   ("paintbrush", "sketchbook"))
     lad = rs.details["ladder"]
@@ -845,7 +853,7 @@ def test_gift_prob_answers_re_weigh_the_re_named_rungs_by_the_same_check():
            "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9},
            "creative things": {"paintbrush": 0.8, "sketchbook": 0.7, "crayons": 0.6}}
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit", rescore_with="ladder")
     rs = k.score_with_answers(TEST, TRAIN, inferred, ("paintbrush", "sketchbook"), {"crayons": True})
     lad = rs.details["ladder"]
@@ -862,16 +870,9 @@ def test_gift_prob_answers_re_weigh_the_re_named_rungs_by_the_same_check():
 def test_gift_prob_answers_as_evidence_drop_a_category_that_ranks_an_answered_no_high_without_lm_calls():
     """rescore_with="evidence": no LM call; the answered test objects join the training objects in the check,
     so a rung that fits the training objects but puts the toothbrush (answered "no") with them is dropped."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "brush things", "middle": "art supplies", "broad": "none"})
-        return category_json("fruit")
-
-    yes = {"fruit": {"banana": 0.9, "apple": 0.9},
-           "brush things": {"paintbrush": 0.9, "sketchbook": 0.6, "toothbrush": 0.9},
-           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9}}
+    answer, yes = fixed_ladder(("brush things", "art supplies", "none")), BRUSH_YES
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, combine="none", rungs="breadth", check="fit", rescore_with="evidence")
     rel = ("paintbrush", "sketchbook")
     base = k.score(TEST, TRAIN, inferred, rel)
@@ -897,18 +898,11 @@ def test_gift_prob_answers_as_evidence_weigh_the_ladders_views_too():
     """After answers as evidence, the scene under each category alone (the intent candidates answers can pick)
     is combined with the MiniLM term under the same weights as the kernel's own score: the answered objects
     count in them."""
-    def answer(messages, seed):
-        if messages[0].content == prompts.LADDER_SYSTEM:
-            return json.dumps({"narrow": "brush things", "middle": "art supplies", "broad": "none"})
-        return category_json("fruit")
-
-    yes = {"fruit": {"banana": 0.9, "apple": 0.9},
-           "brush things": {"paintbrush": 0.9, "sketchbook": 0.6, "toothbrush": 0.9},
-           "art supplies": {"paintbrush": 0.9, "sketchbook": 0.9, "crayons": 0.9}}
+    answer, yes = fixed_ladder(("brush things", "art supplies", "none")), BRUSH_YES
     vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
            "crayons": [0.95, 0.05, 0], "toothbrush": [0.2, 0, 0.9], "apple": [0, 1, 0.1]}
     lm = ScriptedLM(answer=answer, probs=_probs_by_category(yes, 0.3))
-    inferred = Intent(text="The person wanted to pick up the banana.", source="inferred")
+    inferred = PICKED_BANANA
     k = GiftProbKernel(lm=lm, language_kernel=TableKernel(vec), rungs="breadth", rescore_with="evidence")
     rel = ("paintbrush", "sketchbook")
     k.score(TEST, TRAIN, inferred, rel)

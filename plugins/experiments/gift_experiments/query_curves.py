@@ -168,7 +168,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
     which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
     per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy when answers only
-    re-threshold), None when some scene is re-scored or without 2 in the grid."""
+    re-threshold), None when sessions may re-score (``rescore`` and a scene with a re-scorer) or without 2 in the
+    grid."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
     for policy in tuple(policies) + (BASELINE,):

@@ -577,12 +577,9 @@ class GiftProbKernel(RelevanceKernel):
                     descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
         """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels. The objects
         are shown with ``descriptions`` when ``ladder_text="name+description"``."""
-        if self.ladder_text == "name":
-            descriptions = None
-        else:
-            descriptions = {n: (descriptions or {}).get(n, "") for n in (*handled, *left_alone)}
-        key = (kind, tuple(handled), tuple(left_alone),
-               None if descriptions is None else tuple(descriptions.get(n, "") for n in (*handled, *left_alone)))
+        descriptions = None if self.ladder_text == "name" else {n: (descriptions or {}).get(n, "")
+                                                                 for n in (*handled, *left_alone)}
+        key = (kind, tuple(handled), tuple(left_alone), descriptions and tuple(descriptions.values()))
         with self._lock:
             if key in self._ladder_memo:
                 return self._ladder_memo[key]
