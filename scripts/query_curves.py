@@ -215,6 +215,9 @@ def write(result: dict, md: Path) -> None:
                      f"{rand['f1'][k2]:.3f}); random needs {needs} questions per intent for that F1"
                      + (f" (ratio {row2['ratio']:.2f})" if row2["ratio"] else "") + f". Win rate "
                      f"{_fmt(best['win'][0])} -> {_fmt(best['win'][k2])} (random {_fmt(rand['win'][k2])}).")
+        if result.get("rescore") and "rescored_intents" in r and len(r["rescored_intents"]) < len(r["intents"]):
+            lines.append(f"  Re-scored with the answers on {len(r['rescored_intents'])} of {len(r['intents'])} "
+                         "intents; on the others the kernel gave no re-scoring and answers only re-threshold.")
         if "without_rescore" in r:
             w = r["without_rescore"]
             pols = qc.ran_policies(w)

@@ -89,10 +89,24 @@ def test_scenes_are_re_scored_with_the_answers_by_default_and_only_re_thresholde
     sim = qc.simulate([one], random_seeds=1, bands=(), grid=(0, 1, 2))
     assert asked and all(len(a) in (1, 2) for a in asked)
     assert sim["curves"]["uncertainty"]["f1"] == [0.5, 1.0, 1.0] and sim["bound"] is None
+    assert sim["rescored_intents"] == ["one"]
     n = len(asked)
     plain = qc.simulate([one], random_seeds=1, bands=(), grid=(0, 1, 2), rescore=False)
     assert len(asked) == n  # never asked again
     assert plain["curves"]["uncertainty"]["f1"][:2] == [0.5, pytest.approx(2 / 3)] and plain["bound"]["f1"] == 1.0
+    assert plain["rescored_intents"] == []
+
+
+def test_a_kernel_that_gives_no_re_scoring_is_reported_as_not_re_scored_and_keeps_the_ceiling():
+    """A re-scorer that returns None (a kernel without ``score_with_answers``, or ``gift-prob`` with nothing to
+    re-weigh): answers only re-threshold, the run says no intent was re-scored, and the ceiling is reported."""
+    calls = []
+    one = attrs.evolve(DATA[0], rescore=lambda answers: calls.append(dict(answers)))
+    sim = qc.simulate([one], random_seeds=1, bands=(), grid=(0, 1, 2))
+    plain = qc.simulate([DATA[0]], random_seeds=1, bands=(), grid=(0, 1, 2))
+    assert calls and sim["rescored_intents"] == []
+    assert sim["curves"]["uncertainty"]["f1"] == plain["curves"]["uncertainty"]["f1"]
+    assert sim["bound"] == plain["bound"] and sim["bound"]["f1"] == 1.0
 
 
 def test_questions_random_needs_are_interpolated_on_the_grid():

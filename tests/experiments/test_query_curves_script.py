@@ -49,3 +49,21 @@ def test_regenerating_a_page_keeps_what_was_written_by_hand_after_the_marker(scr
     again = md.read_text(encoding="utf-8")
     assert again.startswith(generated) and again.endswith(script.KEEP + "\n\n## A decision\n\nWritten by hand.\n")
     assert again.count("## In short") == 1
+
+
+def test_a_page_says_on_how_many_intents_answers_re_scored_when_not_on_all(script, tmp_path):
+    import json
+
+    saved = Path(__file__).resolve().parents[2] / "docs" / "results" / "queries-evidence" / "curves.json"
+    result = json.loads(saved.read_text(encoding="utf-8"))
+    assert result["rescore"] is True
+    label = "gift-paper | inferred"
+    intents = list(result["runs"][label]["intents"])
+    md = tmp_path / "queries.md"
+    result["runs"][label]["rescored_intents"] = intents  # every intent re-scored: nothing to say
+    script.write(result, md)
+    assert "Re-scored with the answers on" not in md.read_text(encoding="utf-8")
+    result["runs"][label]["rescored_intents"] = intents[:2]
+    script.write(result, md)
+    text = md.read_text(encoding="utf-8")
+    assert f"Re-scored with the answers on 2 of {len(intents)} intents" in text and text.count("Re-scored with") == 1

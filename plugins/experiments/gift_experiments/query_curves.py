@@ -166,20 +166,25 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
     the kernel scores each scene again with the answers where it can (rule 5); ``policies``: the policies run; ``choose``:
     which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
-    ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound"}``; ``bound``: the best 2 questions
-    per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy when answers only
-    re-threshold), None when sessions may re-score (``rescore`` and a scene with a re-scorer) or without 2 in the
-    grid."""
+    ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound", "rescored_intents"}``; ``bound``:
+    the best 2 questions per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy when
+    answers only re-threshold), None when some session re-scored its scene or without 2 in the grid;
+    ``rescored_intents``: the intents where some session's scene was scored again with answers (none with
+    ``rescore=False`` or a kernel that cannot re-score)."""
     curves: dict[str, Any] = {}
     per_intent: dict[str, Any] = {}
+    rescored: set[str] = set()  # intents where some session's scene was actually scored again (rule 5)
     for policy in tuple(policies) + (BASELINE,):
         seeds = range(random_seeds) if policy == BASELINE else (0,)
         runs = []  # per seed: [per k: aggregate]
         by_intent: dict[str, list] = {d.intent: [] for d in data}
         for seed in seeds:
-            outcomes = {d.intent: [outcome(d, st) for st in session(d, policy, seed, grid=grid, move=move,
-                                                                     rescore=rescore, choose=choose)]
-                        for d in data}
+            outcomes = {}
+            for d in data:
+                states = session(d, policy, seed, grid=grid, move=move, rescore=rescore, choose=choose)
+                if any(st.rescored for st in states):
+                    rescored.add(d.intent)
+                outcomes[d.intent] = [outcome(d, st) for st in states]
             runs.append([_aggregate({i: o[k] for i, o in outcomes.items()}) for k in range(len(grid))])
             for i, o in outcomes.items():
                 by_intent[i].append(o)
@@ -202,7 +207,6 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
             last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore, choose=choose)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     bound = None
-    rescored = rescore and any(d.rescore is not None for d in data)
     if 2 in grid and not rescored:  # what any policy could reach with 2 questions (answers only re-threshold)
         found = {d.intent: best_questions(d, 2, move, choose) for d in data}
         bound = {"k": 2, **_aggregate({i: o for i, (_, o) in found.items()}),
@@ -213,7 +217,7 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
                 for d in data}
         abstention[str(band)] = _aggregate(outs)
     return {"grid": list(grid), "curves": curves, "per_intent": per_intent, "abstention": abstention,
-            "bound": bound}
+            "bound": bound, "rescored_intents": [d.intent for d in data if d.intent in rescored]}
 
 
 def ran_policies(curves: Mapping[str, Any]) -> tuple[str, ...]:
