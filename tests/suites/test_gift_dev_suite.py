@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11`` and ``gift-dev12``: new
-intents and objects, none borrowed from the suites they are checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12`` and
+``gift-dev13``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -144,6 +144,19 @@ DEV_SUITES = {
                        r"|juggl|diabolo|\bpoi\b|devil.?sticks?|circus"
                        r"|\btongs?\b"
                        r"|drawstring|draw-?cords?|\bdraw(?:s|n|ing)?\b",
+    },
+    "gift-dev13": {
+        "siblings": [("fans", "spouted_things"), ("pulses", "grinding_things"),
+                     ("climbing_kit", "poker_kit"), ("socks", "buckled_things")],
+        "label_words": r"\bfans?\b|uchiwa|abanico|\bbris[eé]"
+                       r"|\bspouts?\b|spouted|\bneti\b|dallah|porr[oó]n|\bsippy"
+                       r"|\bpulses?\b|lentil|\bbeans?\b|legum|\bdh?aa?l\b|chickpea|garbanzo|borlotti"
+                       r"|grind|\bground\b|\bmill(?:s|ed|ing)?\b|mortar|pestle|suribachi|molcajete|\bcrush|pulveri"
+                       r"|climb|belay|boulder|\bcrags?\b|abseil|rappel|harness|carabin|karabin|quickdraw|descender"
+                       r"|mountaineer"
+                       r"|poker|casino|gambl|hold.?em|\bdeal(?:er|ers|ing)?\b|shuffl|\bchips?\b|\bbets?\b|betting|wager"
+                       r"|\bsocks?\b|hosiery|argyle|footlet|\btabi\b"
+                       r"|buckl",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
