@@ -103,6 +103,15 @@ def test_non_text_answer_is_an_answer_error():
         extract_dict(None)  # type: ignore[arg-type]
 
 
+def test_surrogate_pair_escapes_become_one_character_in_a_python_literal_too():
+    """Found by the fuzz test below: a JSON dict followed by a comment is read as a Python literal, and Python,
+    unlike JSON, keeps a surrogate-pair escape as two code points; the parser joins them either way."""
+    assert extract_dict('{"\\ud800\\udc00": []}\n#') == {"\U00010000": []}
+    assert extract_dict("{'smile': ['\\ud83d\\ude00', {'\\ud83d\\ude00': 1}]}  # a comment") == \
+        {"smile": ["\U0001f600", {"\U0001f600": 1}]}
+    assert extract_dict('{"lone": "\\ud800"}') == {"lone": "\ud800"}  # a lone surrogate stays as written
+
+
 # ---------------------------------------------------------------- fuzzing
 _keys = st.text(min_size=1, max_size=12)
 _leaves = st.none() | st.booleans() | st.integers(-10**6, 10**6) | st.text(max_size=20)

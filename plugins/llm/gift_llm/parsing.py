@@ -209,11 +209,28 @@ def _unescape(body: str) -> str:
         else:
             out.append(body[i:i + 2])
             i += 2
-    text = "".join(out)
-    try:  # join UTF-16 surrogate pairs written as two \\u escapes (JSON's way to spell non-BMP characters)
+    return _join_pairs("".join(out))
+
+
+def _join_pairs(text: str) -> str:
+    """``text`` with UTF-16 surrogate pairs written as two ``\\u`` escapes (JSON's way to spell non-BMP
+    characters) joined into one character; unchanged when it holds a lone surrogate."""
+    try:
         return text.encode("utf-16", "surrogatepass").decode("utf-16")
     except UnicodeError:
         return text
+
+
+def _joined(value: Any) -> Any:
+    """A Python literal's strings (keys and values, nested) with :func:`_join_pairs` applied: Python, unlike
+    JSON, keeps ``"\\ud800\\udc00"`` as two code points."""
+    if isinstance(value, str):
+        return _join_pairs(value)
+    if isinstance(value, dict):
+        return {_joined(k): _joined(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set)):
+        return type(value)(_joined(v) for v in value)
+    return value
 
 
 def _strip_fence(text: str) -> str:
@@ -230,7 +247,7 @@ def _whole(text: str) -> dict | None:
         d = json.loads(body)
     except (ValueError, RecursionError):
         try:
-            d = ast.literal_eval(body)
+            d = _joined(ast.literal_eval(body))
         except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
             return None
     return d if isinstance(d, dict) else None
