@@ -630,7 +630,12 @@ def _lm_usage(comp: Components) -> dict[str, Any] | None:
 
 
 def add_usage(a: Any, b: Any, sign: int = 1) -> Any:
-    """``a + sign * b`` for usage counters; None (no price) counts as nothing, None + None stays None."""
+    """``a + sign * b`` for usage counters; None (no price) counts as nothing, None + None stays None; mappings of
+    counts (answers per build, ``made_by``) add key by key, keys left at 0 dropped."""
+    if isinstance(a, Mapping) or isinstance(b, Mapping):
+        a, b = dict(a or {}), dict(b or {})
+        out = {k: add_usage(a.get(k), b.get(k), sign) for k in list(a) + [k for k in b if k not in a]}
+        return {k: v for k, v in out.items() if v}
     if a is None and b is None:
         return None
     return (a or 0) + sign * (b or 0)

@@ -90,7 +90,8 @@ def _public_counters(stats: Any) -> dict[str, Any] | None:
     import attrs
 
     fields = attrs.asdict(stats, recurse=False) if attrs.has(type(stats)) else vars(stats)
-    return {k: v for k, v in fields.items() if not k.startswith("_")}
+    # a snapshot: mappings of counts (answers per build) are copied, not shared with the live counters
+    return {k: (dict(v) if isinstance(v, dict) else v) for k, v in fields.items() if not k.startswith("_")}
 
 
 class Components:

@@ -197,6 +197,28 @@ def test_lm_usage_of_the_workers_is_summed_into_the_manifest():
     assert "lm" not in manifest([{"started": "a"}], "key")
 
 
+def test_answers_per_build_are_counted_between_snapshots_and_summed_over_workers():
+    """``made_by`` (answers per build of the model runtime) is a mapping of counts: a snapshot does not share it
+    with the live counters, deltas and sums go key by key, and builds left at 0 are dropped."""
+    from gift.study.chain import _usage_delta
+    from gift.study.components import _public_counters
+    from gift.study.sweeps import merge_lm as _merge_lm
+    from gift_llm.usage import UsageStats
+
+    stats = UsageStats()
+    stats.add_made_by("A")
+    before = _public_counters(stats)
+    stats.add_made_by("A")
+    stats.add_made_by("unrecorded")
+    assert before["made_by"] == {"A": 1}  # not the live dict
+    first = {"identity": "llamacpp:m.gguf", "usage": _usage_delta(before, _public_counters(stats))}
+    assert first["usage"]["made_by"] == {"A": 1, "unrecorded": 1}
+    second = {"identity": "llamacpp:m.gguf", "usage": {"requests": 1, "made_by": {"B": 1}}}
+    merged = _merge_lm([first, second])
+    assert merged["usage"]["made_by"] == {"A": 1, "unrecorded": 1, "B": 1}
+    assert _usage_delta({"made_by": {"A": 2}}, {"made_by": {"A": 2, "B": 1}})["made_by"] == {"B": 1}
+
+
 def test_llamacpp_threads_follow_the_worker_budget(local_executor, monkeypatch, tmp_path):
     """Two local workers on N cores: each gets N // 2 threads, so two embedded models do not oversubscribe."""
     budget = max(1, (os.cpu_count() or 1) // local_executor.max_workers)

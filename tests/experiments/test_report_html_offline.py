@@ -335,3 +335,14 @@ def test_the_kernels_as_built_are_in_the_run_section(tmp_path):
         rec["configuration"] = "LanguageKernel(use_descriptions=False, names=True)"
     page = write_html_report(results, tmp_path / "new", render=False).read_text()
     assert "kernels as built" in page and "LanguageKernel(use_descriptions=False, names=True)" in page
+
+
+def test_the_answers_per_build_of_the_lm_runtime_are_listed_in_the_usage_line(tmp_path):
+    results = {"config": {"suite": "gift-paper", "robot": "jaco", "thresholds": ["train-calibrated"]},
+               "manifest": {"lm": {"identity": "llamacpp:m.gguf",
+                                   "usage": {"requests": 3, "hits": 3, "latency_s": 0.25,
+                                             "made_by": {"0.3.36; CPU : AVX512 = 1": 2, "unrecorded": 1}}}}}
+    page = write_html_report(results, tmp_path, render=False).read_text()
+    assert 'class="section-error"' not in page
+    assert "LM usage of the run: requests 3, hits 3, latency_s 0.2" in page
+    assert "made_by (0.3.36; CPU : AVX512 = 1: 2; unrecorded: 1)" in page

@@ -144,3 +144,43 @@ def test_a_cut_hint_is_part_of_the_request_key_and_no_hint_keys_as_before():
     assert request_key("lm", choices_request(plain, ["yes", "no"])) == request_key("lm", choices_request(as_dicts, ["yes", "no"]))
     assert request_key("lm", choices_request(hinted, ["yes", "no"])) != request_key("lm", choices_request(plain, ["yes", "no"]))
     assert choices_request(hinted, ["yes", "no"])["messages"][1]["cut"] == 23
+
+
+class BuiltLM(ScriptedLM):
+    """A scripted backend that reports the build of its runtime, as the llama.cpp backend does."""
+
+    def __init__(self, build, **kw):
+        super().__init__(**kw)
+        self._runtime = build
+
+    def provenance(self):
+        return {"identity": self.identity(), "llama_cpp": self._runtime}
+
+
+def test_each_answer_is_counted_under_the_build_that_made_it(tmp_path, caplog):
+    """Fresh answers are stored with the loaded build; answers read back are counted under the build stored with
+    them (``unrecorded`` for entries from before builds were stored), with one warning when that is not the loaded
+    build; a backend without a build counts nothing."""
+    path = tmp_path / "c.sqlite"
+    plain = CachedLM(ScriptedLM(), path=path)
+    plain.complete([{"role": "user", "content": "old"}])  # an entry stored without a build
+    assert plain.stats.made_by == {} and plain.stats.as_dict()["made_by"] == {}
+    a = CachedLM(BuiltLM("0.3.36; CPU : AVX2 = 1"), path=path)
+    a.complete(MSG)
+    a.choice_probabilities(MSG, ["yes", "no"])
+    assert a.stats.made_by == {"0.3.36; CPU : AVX2 = 1": 2}
+    with sqlite3.connect(path) as db:
+        stored = [json.loads(r) for (r,) in db.execute("select response from entries order by created")]
+    assert [s.get("_made_by") for s in stored] == [None, "0.3.36; CPU : AVX2 = 1", "0.3.36; CPU : AVX2 = 1"]
+    b = CachedLM(BuiltLM("0.3.36; CPU : AVX512 = 1"), path=path)
+    with caplog.at_level("WARNING", logger="gift_llm.cache"):
+        assert b.complete(MSG).text == a.complete(MSG).text
+        assert b.choice_probabilities(MSG, ["yes", "no"]) == {"yes": 0.5, "no": 0.5}  # the build is not a choice
+        b.complete([{"role": "user", "content": "old"}])
+        b.complete([{"role": "user", "content": "new"}])
+    assert b.stats.made_by == {"0.3.36; CPU : AVX2 = 1": 2, "unrecorded": 1, "0.3.36; CPU : AVX512 = 1": 1}
+    assert (b.stats.hits, b.stats.misses) == (3, 1)
+    warned = [r for r in caplog.records if "another build" in r.getMessage()]
+    assert len(warned) == 1 and "AVX512" in warned[0].getMessage()
+    b.stats.reset()
+    assert b.stats.made_by == {}

@@ -77,6 +77,10 @@ def test_repeated_run_with_the_cache_makes_no_model_call(embedded_lm, cache_root
     second = CachedLM(embedded_lm)  # a new run on the same cache file
     out2 = run(second)
     assert out2 == out1 and second.stats.calls == 0 and second.stats.hits == first.stats.misses
+    # every answer is counted under the llama.cpp build (version and CPU kernels) that made it, stored with it
+    build = llamacpp.llama_build()
+    assert "CPU" in build
+    assert first.stats.made_by == {build: first.stats.misses} and second.stats.made_by == {build: second.stats.hits}
 
 
 def test_errors_are_clear(tmp_path, embedded_lm):

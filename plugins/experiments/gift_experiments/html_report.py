@@ -729,8 +729,12 @@ class Report:
         usage = ((self.r.get("manifest") or {}).get("lm") or {}).get("usage") or {}
         head = ""
         if usage:
-            head = ("<p>LM usage of the run: " + ", ".join(f"{esc(k)} {_num(v, 1) if isinstance(v, float) else esc(v)}"
-                                                           for k, v in usage.items()) + ".</p>")
+            def shown(v: Any) -> str:
+                if isinstance(v, Mapping):  # answers per build of the model runtime (made_by)
+                    return "(" + "; ".join(f"{esc(b)}: {esc(n)}" for b, n in v.items()) + ")" if v else "(none)"
+                return _num(v, 1) if isinstance(v, float) else esc(v)
+
+            head = "<p>LM usage of the run: " + ", ".join(f"{esc(k)} {shown(v)}" for k, v in usage.items()) + ".</p>"
         if not self.lm_record.is_file():
             return head + _missing(f"No LM call record ({self.lm_record.name}) in this folder: the run made no LM "
                                    "call, or was not run by gift demo / gift reproduce.")

@@ -26,6 +26,7 @@ import contextlib
 import errno
 import hashlib
 import json
+import logging
 import os
 import sqlite3
 import threading
@@ -48,6 +49,7 @@ from gift_llm.usage import MeteredLM
 if TYPE_CHECKING:
     from gift_llm.redis_store import RedisStore
 
+log = logging.getLogger(__name__)
 _OFF = {"0", "off", "false", "no", "disabled"}
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS entries (
@@ -350,6 +352,13 @@ def _unflock(path: Path, fd: int) -> None:
         os.close(fd)
 
 
+#: Key under which a cached answer stores the build that made it (:meth:`CachedLM.build`); not an answer field.
+MADE_BY = "_made_by"
+#: How :attr:`gift_llm.usage.UsageStats.made_by` counts cached answers stored before builds were recorded.
+UNRECORDED = "unrecorded"
+_UNSET = object()
+
+
 class CachedLM(MeteredLM):
     """An :class:`LMBackend` that answers repeated requests from the persistent cache.
 
@@ -368,6 +377,35 @@ class CachedLM(MeteredLM):
         self.enabled = bool(enabled) and cache_enabled_by_env()
         self.store = open_store(path, url) if self.enabled else None
         self._last = threading.local()
+        self._build: str | None | object = _UNSET
+        self._warned_build = False
+
+    def build(self) -> str | None:
+        """The build of the model runtime that makes this backend's fresh answers (the llama.cpp build and its
+        CPU kernels, ``provenance()["llama_cpp"]``), stored with each answer it caches; None when the backend has
+        no such build (hosted models)."""
+        if self._build is _UNSET:
+            try:
+                prov = self.provenance()
+            except Exception:  # noqa: BLE001 - a backend that cannot describe itself records no build
+                prov = {}
+            self._build = prov.get("llama_cpp") or prov.get("build") or None
+        return self._build  # type: ignore[return-value]
+
+    def _count_build(self, stored: Mapping[str, Any] | None) -> None:
+        """Count one answer under the build that made it (:attr:`UsageStats.made_by`): the loaded build for a
+        fresh answer (``stored`` None), else the build stored with the cached answer, ``"unrecorded"`` when the
+        answer predates builds being stored. Warns once when cached answers come from another build."""
+        now = self.build()
+        made = now if stored is None else stored.get(MADE_BY)
+        if made is None and now is None:
+            return
+        self.stats.add_made_by(made or UNRECORDED)
+        if stored is not None and made != now and not self._warned_build:
+            self._warned_build = True
+            log.warning("LM answers read from the cache were made by another build of the model runtime (%s) than "
+                        "the one loaded (%s); the results' manifest counts answers per build (lm.usage.made_by)",
+                        made or UNRECORDED, now or "none recorded")
 
     def last_hit(self) -> bool | None:
         """Whether this thread's last request was answered from the cache (None: none yet, or cache off)."""
@@ -384,10 +422,15 @@ class CachedLM(MeteredLM):
                     self.stats.add_request(hit=False)
                     self._last.hit = False
                     out = call()
-                    self.store.put(key, kind, identity, request, encode(out))
+                    payload = encode(out)
+                    if self.build() is not None:
+                        payload = {**payload, MADE_BY: self.build()}
+                    self.store.put(key, kind, identity, request, payload)
+                    self._count_build(None)
                     return None, out
         self.stats.add_request(hit=True)
         self._last.hit = True
+        self._count_build(hit if isinstance(hit, Mapping) else {})
         return hit, None
 
     def complete(self, messages: Sequence[Message], *, temperature: float = 0.0, seed: int | None = None,

@@ -30,6 +30,10 @@ class UsageStats:
     completion_tokens: int = 0
     latency_s: float = 0.0
     cost_usd: float | None = None
+    #: Answers per build of the model runtime that made them (``{build: count}``; :class:`gift_llm.cache.CachedLM`
+    #: counts fresh answers under the loaded build and cached ones under the build stored with them, ``"unrecorded"``
+    #: for answers cached before builds were recorded). Empty for backends without a build (hosted models).
+    made_by: dict[str, int] = attrs.field(factory=dict)
     _lock: threading.Lock = attrs.field(factory=threading.Lock, repr=False, eq=False)
 
     @property
@@ -58,8 +62,13 @@ class UsageStats:
             elif hit is False:
                 self.misses += 1
 
+    def add_made_by(self, build: str) -> None:
+        with self._lock:
+            self.made_by[build] = self.made_by.get(build, 0) + 1
+
     def as_dict(self) -> dict[str, Any]:
         d = {f.name: getattr(self, f.name) for f in attrs.fields(type(self)) if not f.name.startswith("_")}
+        d["made_by"] = dict(self.made_by)
         d["tokens"] = self.tokens
         return d
 
@@ -67,7 +76,8 @@ class UsageStats:
         with self._lock:
             for f in attrs.fields(type(self)):
                 if not f.name.startswith("_"):
-                    setattr(self, f.name, f.default)
+                    d = f.default
+                    setattr(self, f.name, d.factory() if isinstance(d, attrs.Factory) else d)
 
 
 class LMWrapper(LMBackend):
