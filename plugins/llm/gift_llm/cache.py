@@ -381,15 +381,15 @@ class CachedLM(MeteredLM):
         self._warned_build = False
 
     def build(self) -> str | None:
-        """The build of the model runtime that makes this backend's fresh answers (the llama.cpp build and its
-        CPU kernels, ``provenance()["llama_cpp"]``), stored with each answer it caches; None when the backend has
-        no such build (hosted models)."""
+        """The build of the model runtime that makes this backend's fresh answers (the wrapped backend's
+        ``build()``: for ``llamacpp`` the llama.cpp version and its CPU kernels), stored with each answer it
+        caches; None when the backend has no such build (hosted models)."""
         if self._build is _UNSET:
+            made_by = getattr(self.inner, "build", None)  # wrappers pass the lookup on to what they wrap
             try:
-                prov = self.provenance()
-            except Exception:  # noqa: BLE001 - a backend that cannot describe itself records no build
-                prov = {}
-            self._build = prov.get("llama_cpp") or prov.get("build") or None
+                self._build = (made_by() or None) if callable(made_by) else None
+            except Exception:  # noqa: BLE001 - a backend that cannot describe its build records none
+                self._build = None
         return self._build  # type: ignore[return-value]
 
     def _count_build(self, stored: Mapping[str, Any] | None) -> None:

@@ -319,7 +319,12 @@ class LlamaCppLM(LMBackend):
         from gift.core.provenance import file_sha256
 
         return {"identity": self.identity(), "model_path": str(self.path), "model_sha256": file_sha256(self.path),
-                "llama_cpp": llama_build()}
+                "llama_cpp": self.build()}
+
+    def build(self) -> str:
+        """The llama.cpp build that computes this backend's answers (:func:`llama_build`); the LM cache stores it
+        with each answer (:meth:`gift_llm.cache.CachedLM.build`)."""
+        return llama_build()
 
     def _grammar(self, schema: Mapping[str, Any]) -> Any:
         from llama_cpp import LlamaGrammar
