@@ -804,12 +804,14 @@ def test_gift_prob_both_ladders_average_the_breadth_and_the_facet_rungs_without_
     assert systems.count(prompts.LADDER_SYSTEM) == systems.count(prompts.FACET_SYSTEM) == 1 + len(TRAIN)
 
 
-@pytest.mark.parametrize("check", ["fit", "weight"])
+@pytest.mark.parametrize("check", ["fit", "weight", "margin", "fit-best"])
 def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_objects_it_was_named_from(check):
-    """check="fit" / "weight": the goal's category and every rung are asked of the training objects as named
-    (in-sample); a category whose answers invert the demonstrated objects (the goal's "fruit") gets no weight,
-    "fit" keeps only the categories that put every demonstrated object above every left-alone one, "weight"
-    weighs each by AUC - 1/2. The LM term is the weighted mean of the z-scored log-odds."""
+    """check="fit" / "weight" / "margin" / "fit-best": the goal's category and every rung are asked of the
+    training objects as named (in-sample); a category whose answers invert the demonstrated objects (the goal's
+    "fruit") gets no weight, "fit" keeps only the categories that put every demonstrated object above every
+    left-alone one, "weight" weighs each by AUC - 1/2, "margin" weighs those "fit" keeps by the log-odds gap
+    between the lowest demonstrated object and the highest left-alone one, "fit-best" keeps the widest gap
+    alone. The LM term is the weighted mean of the z-scored log-odds."""
     answer = fixed_ladder(("painting tools", "art supplies", "creative things"))
 
     yes = {"fruit": {"banana": 0.9, "apple": 0.9}, "painting tools": {"paintbrush": 0.9},
@@ -824,7 +826,12 @@ def test_gift_prob_check_weighs_each_category_by_how_it_separates_the_training_o
     # in-sample AUC on the training objects: fruit ranks the banana first, painting tools ties the sketchbook with
     # the left-alone objects
     assert lad["check"]["in_sample_auc"] == [0.25, 0.75, 1.0, 1.0]
-    expected = {"fit": [0.0, 0.0, 0.5, 0.5], "weight": [0.0, 0.25 / 1.25, 0.5 / 1.25, 0.5 / 1.25]}[check]
+    logit = lambda p: np.log(p / (1 - p))  # noqa: E731
+    gaps = [logit(0.9) - logit(0.3), logit(0.7) - logit(0.3)]  # art supplies, creative things
+    assert np.allclose(lad["check"]["margin"][2:], gaps)
+    assert lad["check"]["margin"][0] < 0 and lad["check"]["margin"][1] == 0.0  # the sketchbook ties at 0.3
+    expected = {"fit": [0.0, 0.0, 0.5, 0.5], "weight": [0.0, 0.25 / 1.25, 0.5 / 1.25, 0.5 / 1.25],
+                "margin": [0.0, 0.0, gaps[0] / sum(gaps), gaps[1] / sum(gaps)], "fit-best": [0.0, 0.0, 1.0, 0.0]}[check]
     assert np.allclose(lad["check"]["weights"], expected)
     views = [np.asarray(lad["goal"])] + [np.asarray(t["test"] + t["train"]) for t in lad["terms"]]
     z = [(v - v.mean()) / v.std() for v in views]

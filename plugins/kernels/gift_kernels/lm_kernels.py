@@ -244,7 +244,7 @@ CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
 RUNGS = ("breadth", "facets", "both")
-CHECK = ("none", "fit", "weight")
+CHECK = ("none", "fit", "weight", "margin", "fit-best")
 #: How :meth:`GiftProbKernel.score_with_answers` uses the human's answers: ``"ladder"`` names the category ladder
 #: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
 #: as labelled evidence beside the training objects.
@@ -310,7 +310,9 @@ class GiftProbKernel(RelevanceKernel):
     kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``), ``check``
     (``"fit"``, the default: each of the ladder's categories is first asked of the training objects as named and
     kept only if it puts every demonstrated object above every left-alone one; ``"weight"``: weighted by its
-    AUC - 1/2 there; ``"none"``: all averaged as they are), ``rescore_with`` (what the human's answers do when the
+    AUC - 1/2 there; ``"margin"``: those "fit" keeps, weighted by their log-odds gap between the lowest
+    demonstrated and the highest left-alone object; ``"fit-best"``: the widest gap alone; ``"none"``: all
+    averaged as they are), ``rescore_with`` (what the human's answers do when the
     scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"`` names the ladder again with
     them; ``"evidence"``, the default, asks the LM nothing new and counts them beside the training objects),
     ``ladder_text`` (how the ladder's questions show each object: ``"name"``, the default, or
@@ -408,7 +410,9 @@ class GiftProbKernel(RelevanceKernel):
         #: were named from before they are averaged: each is asked of every training object as named (in-sample)
         #: and scored by its AUC separating the demonstrated objects from the left-alone ones. ``"none"``: the
         #: plain mean of all; ``"fit"``: the mean of those with AUC 1 (else those with the best AUC);
-        #: ``"weight"``: weights ``max(AUC - 1/2, 0)`` (all zero: the plain mean). Costs ``n_train`` yes/no
+        #: ``"weight"``: weights ``max(AUC - 1/2, 0)`` (all zero: the plain mean); ``"margin"``: of those "fit"
+        #: keeps, each weighted by its in-sample gap (lowest demonstrated minus highest left-alone log-odds; no
+        #: positive gap: as "fit"); ``"fit-best"``: the widest gap alone. Costs ``n_train`` yes/no
         #: questions per category. "fit" is the default since front_half.md section 14 (a rule written before a
         #: fifth development suite was seen: level or better there, and better pooled over all 38 dev intents).
         self.check = check
@@ -669,19 +673,28 @@ class GiftProbKernel(RelevanceKernel):
         extra, labels = evidence if evidence is not None else ([np.zeros(0)] * len(categories), np.zeros(0, bool))
         labels = np.asarray(labels, dtype=bool)
         pos, neg = rel.any() or labels.any(), (~rel).any() or (~labels).any()
-        aucs = np.array([roc_auc(np.concatenate([self.log_odds(train, intent, [c] * len(train)), x]),
-                                 np.concatenate([rel, labels])) if c is not None and pos and neg
-                         else float("nan") for c, x in zip(categories, extra)])
+        y = np.concatenate([rel, labels])
+        scored = [np.concatenate([self.log_odds(train, intent, [c] * len(train)), x])
+                  if c is not None and pos and neg else None for c, x in zip(categories, extra)]
+        aucs = np.array([float("nan") if v is None else roc_auc(v, y) for v in scored])
+        # the gap between the lowest-scored demonstrated object and the highest-scored other one (log-odds)
+        margins = np.array([float("nan") if v is None else float(v[y].min() - v[~y].max()) for v in scored])
         known = ~np.isnan(aucs)
         weights = np.ones(len(categories))
         if known.any():
-            if self.check == "fit":
+            if self.check in ("fit", "margin", "fit-best"):
                 top = 1.0 if (aucs[known] >= 1.0 - 1e-12).any() else aucs[known].max()
                 weights = (known & (np.nan_to_num(aucs, nan=-1.0) >= top - 1e-12)).astype(float)
+                gap = np.where(weights > 0, np.nan_to_num(margins, nan=-np.inf), -np.inf)
+                if self.check == "margin" and (gap > 0).any():
+                    weights = np.clip(gap, 0.0, None)
+                elif self.check == "fit-best":
+                    weights = (np.arange(len(weights)) == int(np.argmax(gap))).astype(float)
             else:
                 sep = np.clip(np.nan_to_num(aucs, nan=0.5) - 0.5, 0.0, None)
                 weights = sep if sep.sum() > 0 else weights
         record["check"] = {"mode": self.check, "in_sample_auc": [None if np.isnan(a) else float(a) for a in aucs],
+                           "margin": [None if np.isnan(m) else float(m) for m in margins],
                            "weights": (weights / weights.sum()).tolist()}
         return weights
 
