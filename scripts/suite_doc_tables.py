@@ -39,6 +39,8 @@ DEV12_LABEL = {"olives": "o1a", "fortune_telling": "o1b", "conifer_cones": "o2a"
                "ballet_kit": "o3a", "juggling_kit": "o3b", "tongs": "o4a", "drawstring_things": "o4b"}
 DEV13_LABEL = {"fans": "p1a", "spouted_things": "p1b", "pulses": "p2a", "grinding_things": "p2b",
                "climbing_kit": "p3a", "poker_kit": "p3b", "socks": "p4a", "buckled_things": "p4b"}
+DEV14_LABEL = {"cakes": "q1a", "bristled_things": "q1b", "flours": "q2a", "tasselled_things": "q2b",
+               "orienteering_kit": "q3a", "chess_kit": "q3b", "sieves": "q4a", "stamping_things": "q4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -89,7 +91,7 @@ def catalog_size(doc: str, name: str, n: int) -> str:
 DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3": DEV3_LABEL, "gift-dev4": DEV4_LABEL,
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
-                    "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL}
+                    "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL}
 
 
 def main() -> None:
