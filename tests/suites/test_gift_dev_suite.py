@@ -1,6 +1,6 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
-``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12`` and
-``gift-dev13``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
+``gift-dev13`` and ``gift-dev14``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -157,6 +157,18 @@ DEV_SUITES = {
                        r"|poker|casino|gambl|hold.?em|\bdeal(?:er|ers|ing)?\b|shuffl|\bchips?\b|\bbets?\b|betting|wager"
                        r"|\bsocks?\b|hosiery|argyle|footlet|\btabi\b"
                        r"|buckl",
+    },
+    "gift-dev14": {
+        "siblings": [("cakes", "bristled_things"), ("flours", "tasselled_things"),
+                     ("orienteering_kit", "chess_kit"), ("sieves", "stamping_things")],
+        "label_words": r"\bcakes?\b|cupcake|g[aâ]teau|\bsponges?\b|madeleine|lamington|battenberg"
+                       r"|bristl|\bbrush|\bbrooms?\b|besom|kabuki|mascara|dauber"
+                       r"|\bflours?\b|\batta\b|besan|harina"
+                       r"|tassel"
+                       r"|orienteer|\bcompass|sportident|dibber"
+                       r"|\bchess|checkmate|staunton"
+                       r"|\bsieves?\b|\bsift|strainer|\bstrain(?:s|ed|ing)?\b|colander|chinois|tamis"
+                       r"|\bstamp|\bseal(?:s|ed|ing)?\b|hanko|emboss|signet",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
