@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from gift.core.queries import DisagreementPolicy, ErrorBoundPolicy, RandomPolicy, UncertaintyPolicy
+from gift.core.queries import (DisagreementPolicy, ErrorBoundPolicy, ExpectedErrorPolicy, RandomPolicy,
+                               UncertaintyPolicy)
 from gift.plugins.hookspecs import hookimpl
 
 
@@ -14,4 +15,6 @@ def gift_register_query_policies(register):
                                              "gift-prob's LM and MiniLM) disagree on most")
     register(ErrorBoundPolicy, description="the object whose answer is expected to lower the error bound of "
                                            "the scene's trajectories most")
+    register(ExpectedErrorPolicy, description="the object whose answer, re-scoring the scene, is expected to leave "
+                                              "the fewest wrong decisions (expected error reduction)")
     register(RandomPolicy, description="an object drawn uniformly among those not asked yet (the baseline)")

@@ -784,6 +784,41 @@ class ErrorBoundPolicy(QueryPolicy):
         return out
 
 
+class ExpectedErrorPolicy(QueryPolicy):
+    """Ask about the object whose answer is expected to leave the fewest wrong decisions in the scene (expected
+    error reduction, with the kernel's own beliefs): for each of the ``width`` objects nearest the cut that were
+    not asked, the scene is resolved with a "yes" and with a "no" as asking would resolve it (rule 5: a kernel that
+    can use answers re-scores the scene, ``gift-prob`` without an LM call), and the expected mistakes left,
+    ``Σ_j min(b_j, 1 - b_j)`` over the objects not asked before (``b``: :meth:`QueryState.belief` of the state after
+    the answer; the asked object counts 0), are averaged with weights ``p`` and ``1 - p`` (``p``: its belief now).
+    Priority: the reduction against now; objects outside the ``width`` nearest rank below every evaluated one. Without re-scoring (answers only fix their object and the cut stays) the reduction is the asked
+    object's own ``min(p, 1 - p)``, which ranks as ``uncertainty``. Cost: ``2 * width`` resolves per question."""
+
+    name: ClassVar[str] = "expected-error"
+
+    def __init__(self, width: int = 6) -> None:
+        if not isinstance(width, (int, np.integer)) or isinstance(width, bool) or width < 1:
+            raise GiftError(f"expected-error: width must be an integer >= 1, got {width!r}")
+        self.width = int(width)
+
+    def priority(self, state: QueryState, rng: np.random.Generator) -> np.ndarray:
+        open_ = ~state.asked
+        p = state.belief()
+        now = float(np.minimum(p, 1.0 - p)[open_].sum())
+        dist = np.abs(state.scores.decision - state.cut)
+        idx = np.flatnonzero(open_)
+        idx = idx[np.lexsort((idx, np.round(dist[idx], 12)))][: self.width]
+        out = np.full(len(state.test), -1.0 - len(state.test))  # below any reduction (each is >= -n_test / 2)
+        for i in idx:
+            left = []
+            for said in (True, False):
+                after = resolve(state.problem, state.answers + (Answer(state.test[i], said),))
+                b = after.belief()
+                left.append(float(np.minimum(b, 1.0 - b)[open_].sum()))
+            out[i] = now - (p[i] * left[0] + (1.0 - p[i]) * left[1])
+        return out
+
+
 class RandomPolicy(QueryPolicy):
     """Ask about an object drawn uniformly among those not asked yet (the baseline)."""
 
@@ -793,4 +828,4 @@ class RandomPolicy(QueryPolicy):
         return rng.random(len(state.test))
 
 
-BUILTIN_POLICIES = (UncertaintyPolicy, DisagreementPolicy, ErrorBoundPolicy, RandomPolicy)
+BUILTIN_POLICIES = (UncertaintyPolicy, DisagreementPolicy, ErrorBoundPolicy, ExpectedErrorPolicy, RandomPolicy)

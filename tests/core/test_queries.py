@@ -383,9 +383,8 @@ class Broken(QueryPolicy):
 
 
 def test_query_policies_are_plugins_and_bad_priorities_are_named():
-    assert {"uncertainty", "disagreement", "error-bound", "random"} <= set(gift.list_components("query_policy")
-                                                                         ["query_policy"][i]["name"]
-                                                                         for i in range(4))
+    names = {c["name"] for c in gift.list_components("query_policy")["query_policy"]}
+    assert {"uncertainty", "disagreement", "error-bound", "expected-error", "random"} <= names
 
     class Plugin:
         @gift.hookimpl
@@ -449,6 +448,39 @@ def test_rule_5_a_kernel_that_uses_answers_re_scores_the_scene_once_per_set_of_a
     st = align_with_queries(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"), answer=labels_answerer(LABELS),
                             n=2, policy="uncertainty", rescore=False)
     assert not st.rescored and k.calls == []
+
+
+def test_expected_error_asks_the_object_whose_answer_re_scores_the_others_most_and_is_uncertainty_without_it():
+    first = {"x": 0.9, "y": 0.55, "z": 0.45, "w": 0.3}
+    train = {"a": 0.8, "b": 0.7, "c": 0.2, "d": 0.1}
+    settled = {"x": 0.95, "y": 0.05, "z": 0.95, "w": 0.3}  # an answer about w settles y and z
+
+    def rescore(answers):
+        table = settled if "w" in answers else first
+        return score_alignment(FixedRelevance(table, train), objs(TEST), objs(TRAIN), relevant_train=("a", "b"))
+
+    s = score_alignment(FixedRelevance(first, train), objs(TEST), objs(TRAIN), relevant_train=("a", "b"))
+    pol = gift.get_query_policy("expected-error")
+    st = resolve(QueryProblem.of(s, rescore=rescore))
+    p = st.belief()
+    pr = pol.priority(st, np.random.default_rng(0))
+    # by its definition: the mistakes expected now minus those expected after each answer, weighed by p
+    left = lambda b: float(np.minimum(b, 1 - b).sum())
+    for i, t in enumerate(TEST):
+        after = [resolve(st.problem, [Answer(t, said)]).belief() for said in (True, False)]
+        assert pr[i] == pytest.approx(left(p) - (p[i] * left(after[0]) + (1 - p[i]) * left(after[1])))
+    nearest = gift.get_query_policy("uncertainty").choose(st, np.random.default_rng(0))
+    assert nearest == "z" and pol.choose(st, np.random.default_rng(0)) == "w"  # not the nearest to the cut
+    # answers that only fix their object: the gain is the object's own min(p, 1 - p), ranked as uncertainty
+    plain = resolve(QueryProblem.of(s))
+    pr = pol.priority(plain, np.random.default_rng(0))
+    assert pr == pytest.approx(np.minimum(plain.belief(), 1 - plain.belief()))
+    assert pol.choose(plain, np.random.default_rng(0)) == "z"
+    # only the `width` objects nearest the cut are evaluated; the others rank below them
+    narrow = gift.get_query_policy("expected-error", width=1).priority(st, np.random.default_rng(0))
+    assert np.argmax(narrow) == TEST.index("z") and (np.delete(narrow, 2) < narrow[2]).all()
+    with pytest.raises(GiftError, match="width must be an integer >= 1"):
+        gift.get_query_policy("expected-error", width=0)
 
 
 def test_rule_5_kernels_that_cannot_use_answers_only_re_threshold_and_bad_rescores_fail_clearly():

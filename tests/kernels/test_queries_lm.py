@@ -13,8 +13,8 @@ import gift
 from gift.core.alignment import score_alignment
 from gift.core.data import DISTRACTOR, Intent
 from gift.core.metrics import binary_metrics
-from gift.core.queries import (QueryProblem, align_with_queries, answered_cut, ask, asking, belief, kernel_rescorer,
-                               labels_answerer, resolve)
+from gift.core.queries import (Answer, QueryProblem, align_with_queries, answered_cut, ask, asking, belief,
+                               kernel_rescorer, labels_answerer, resolve)
 from gift.core.suite import load_suite
 
 pytestmark = [pytest.mark.slow, pytest.mark.lm]
@@ -195,6 +195,34 @@ def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene
     for i, t in enumerate(TEST):
         a = after.answer_of(t)
         assert after.predicted[i] == (labels[t] if a is not None else after.scores.decision[i] >= after.cut)
+
+
+def test_expected_error_looks_ahead_with_the_real_kernels_re_scoring_without_asking_the_lm(scene):
+    """``expected-error`` on the real kernel (an inferred intent, answers weighed as evidence): each object it
+    weighs is resolved with a "yes" and a "no", each re-scoring the real scene; no LM question is asked."""
+    kernel, test, train, _, spec, _, labels = scene
+    inferred = Intent(text=spec.text, source="inferred")
+    first = score_alignment(kernel, test, train, inferred, relevant_train=spec.relevant_train)
+    problem = QueryProblem.of(first, rescore=kernel_rescorer(kernel, test, train, inferred,
+                                                             relevant_train=spec.relevant_train))
+    calls = kernel.calls
+    before = resolve(problem)
+    pol = gift.get_query_policy("expected-error")
+    gain = pol.priority(before, np.random.default_rng(0))
+    p = before.belief()
+    left = lambda b: float(np.minimum(b, 1 - b).sum())
+    for i, t in enumerate(TEST):  # width 6: every object of this scene is weighed, by the policy's definition
+        yes, no = (resolve(problem, [Answer(t, said)]) for said in (True, False))
+        assert yes.rescored and no.rescored
+        assert gain[i] == pytest.approx(left(p) - (p[i] * left(yes.belief()) + (1 - p[i]) * left(no.belief())))
+    states = list(asking(problem, pol, labels_answerer(labels), 2))
+    assert kernel.calls == calls  # every re-scoring weighed the answers as evidence: no LM question
+    assert states[1].answers[0].object == TEST[int(np.argmax(np.round(gain, 12)))] or \
+        np.isclose(gain[TEST.index(states[1].answers[0].object)], gain.max())
+    after = states[-1]
+    assert len({a.object for a in after.answers}) == 2 and after.rescored
+    for a in after.answers:
+        assert after.predicted[TEST.index(a.object)] == labels[a.object]
 
 
 def test_evaluate_alignment_queries_re_score_with_the_real_ladder_unless_told_not_to(tmp_path, capsys):

@@ -48,7 +48,8 @@ log = logging.getLogger(__name__)
 REPORT = "report.html"
 QUERY_CURVES = "query_curves.json"
 #: Colours of the query policies in the query curves (those of :func:`gift_experiments.query_curves.figure`).
-POLICY_COLOURS = {"uncertainty": "#1f77b4", "disagreement": "#ff7f0e", "error-bound": "#2ca02c", "random": "#7f7f7f"}
+POLICY_COLOURS = {"uncertainty": "#1f77b4", "disagreement": "#ff7f0e", "error-bound": "#2ca02c",
+                  "expected-error": "#9467bd", "random": "#7f7f7f"}
 ORACLE = "oracle-labels"
 THUMB_PX = 72
 #: At most this many LM calls are written into the page (the rest stay in lm_calls.jsonl).

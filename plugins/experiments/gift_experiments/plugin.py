@@ -61,7 +61,7 @@ def add_query_arguments(p: argparse.ArgumentParser) -> None:
                         "'is this object part of the goal?' and re-score (default 0); adds a row per kernel")
     p.add_argument("--policy", default="uncertainty", metavar="NAME",
                    help="query policy choosing the questions: uncertainty (default), disagreement, error-bound, "
-                        "random, or another registered one (gift plugins)")
+                        "expected-error, random, or another registered one (gift plugins)")
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects whose decision score is within BAND of the cut; "
                         "their features are dropped like a distractor's (default 0: never)")
