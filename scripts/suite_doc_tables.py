@@ -41,6 +41,8 @@ DEV13_LABEL = {"fans": "p1a", "spouted_things": "p1b", "pulses": "p2a", "grindin
                "climbing_kit": "p3a", "poker_kit": "p3b", "socks": "p4a", "buckled_things": "p4b"}
 DEV14_LABEL = {"cakes": "q1a", "bristled_things": "q1b", "flours": "q2a", "tasselled_things": "q2b",
                "orienteering_kit": "q3a", "chess_kit": "q3b", "sieves": "q4a", "stamping_things": "q4b"}
+DEV15_LABEL = {"crackers": "r1a", "belled_things": "r1b", "rice": "r2a", "zipped_things": "r2b",
+               "pony_grooming": "r3a", "tea_ceremony": "r3b", "spanners": "r4a", "gift_wrapping": "r4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -91,7 +93,8 @@ def catalog_size(doc: str, name: str, n: int) -> str:
 DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3": DEV3_LABEL, "gift-dev4": DEV4_LABEL,
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
-                    "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL}
+                    "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
+                    "gift-dev15": DEV15_LABEL}
 
 
 def main() -> None:
