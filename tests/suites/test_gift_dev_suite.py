@@ -1,6 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13`` and ``gift-dev14``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev13``, ``gift-dev14`` and ``gift-dev15``: new intents and objects, none borrowed from the suites they are
+checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -169,6 +170,18 @@ DEV_SUITES = {
                        r"|\bchess|checkmate|staunton"
                        r"|\bsieves?\b|\bsift|strainer|\bstrain(?:s|ed|ing)?\b|colander|chinois|tamis"
                        r"|\bstamp|\bseal(?:s|ed|ing)?\b|hanko|emboss|signet",
+    },
+    "gift-dev15": {
+        "siblings": [("crackers", "belled_things"), ("rice", "zipped_things"),
+                     ("pony_grooming", "tea_ceremony"), ("spanners", "gift_wrapping")],
+        "label_words": r"cracker|matzo|senbei|hardtack|water.?biscuit"
+                       r"|\bbells?\b|\bbelled\b|jingl|ghungr"
+                       r"|\brice\b|basmati|arborio|carnaroli|\bbomba\b|koshihikari|camargue|risott|paella|sushi"
+                       r"|\bzip"
+                       r"|\bgroom|\bpon(?:y|ies)\b|\bhorse|equine|equestr|\bhoo(?:f|fs|ves)\b|\bmanes?\b|curry.?comb"
+                       r"|ceremon|chanoyu|\bchad[oō]\b|chasen|chashaku|chawan|fukusa|kaishi|kensui|\braku\b"
+                       r"|spanner|wrench|stillson|ratchet|\bsockets?\b|wheel.?brace"
+                       r"|\bwrap|\bgifts?\b|\bpresents?\b|furoshiki",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
