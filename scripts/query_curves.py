@@ -106,7 +106,8 @@ def run(args: argparse.Namespace) -> dict:
 
 def merge(results: list[dict]) -> dict:
     """One result from several saved ones (each a ``curves.json``): their runs, suites and failures together;
-    the first one's provenance, with every one's command, commit and code version kept under ``parts``.
+    the first one's provenance, with every one's command, commit and code version kept under ``parts`` (a result
+    that is itself merged contributes its own parts, so a page merged again still names every run's commit).
     Runs of different recipes (kernel, re-scoring, LM model file) are refused."""
     first = results[0]
     keys = ("kernel", "rescore", "random_seeds", "move", "choose")
@@ -117,7 +118,8 @@ def merge(results: list[dict]) -> dict:
         if (r.get("lm") or {}).get("model_sha256") != (first.get("lm") or {}).get("model_sha256"):
             raise SystemExit("cannot merge runs made with different LM model files")
     out = {**first, "runs": {}, "suites": {}, "failures": [], "seconds": 0.0,
-           "parts": [{k: r.get(k) for k in ("command", "git", "code_version", "seconds")} for r in results]}
+           "parts": [p for r in results
+                     for p in (r.get("parts") or [{k: r.get(k) for k in ("command", "git", "code_version", "seconds")}])]}
     for r in results:
         out["runs"].update(r["runs"])
         out["suites"].update(r["suites"])

@@ -29,6 +29,11 @@ def test_a_merged_page_names_the_commit_and_code_version_of_each_part(script):
     assert "commit `bbbbbbbbbb`, code version `222222222222` (40 s)" in line
     # one run: its own commit, as before
     assert script.provenance(_run("c" * 40, "3" * 16, "s3", 1.0)) == "Commit `cccccccccc`, code version `333333333333`"
+    # merging a merged page again keeps each of its parts
+    again = script.merge([merged, _run("e" * 40, "5" * 16, "s5", 5.0)])
+    assert [p["git"]["commit"][0] for p in again["parts"]] == ["a", "b", "e"] and again["seconds"] == 645.0
+    assert set(again["runs"]) == {"s1 | inferred", "s2 | inferred", "s5 | inferred"}
+    assert "commit `bbbbbbbbbb`" in script.provenance(again) and "commit `eeeeeeeeee`" in script.provenance(again)
     other = _run("d" * 40, "4" * 16, "s4", 1.0)
     other["lm"] = {"model_sha256": "other"}
     with pytest.raises(SystemExit, match="different LM model files"):
