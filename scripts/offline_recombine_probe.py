@@ -93,10 +93,11 @@ def size_weights(mode: str) -> Callable[[np.ndarray, np.ndarray, int, int], np.n
     return weigh
 
 
-def scored(run: dict, kernel: str, weigh=None, combine=combine_mean, offset: float = 0.0) -> tuple[int, int, int]:
-    """Pooled (tp, fp, fn) of one run with the categories weighed by ``weigh`` (None: the saved weights), the terms
-    combined by ``combine`` and the cut moved by ``offset`` on the z-scale."""
-    suite = recorded_suite(run, kernel)
+def scored(run: dict, suite, kernel: str, weigh=None, combine=combine_mean,
+           offset: float = 0.0) -> tuple[int, int, int]:
+    """Pooled (tp, fp, fn) of one run (scored on ``suite``, :func:`recorded_suite`) with the categories weighed by
+    ``weigh`` (None: the saved weights), the terms combined by ``combine`` and the cut moved by ``offset`` on the
+    z-scale."""
     tp = fp = fn = 0
     for intent_id, rec in run["kernels"][kernel]["intents"].items():
         labels = {t.object: t.relevant for t in suite.intent(intent_id).test}
@@ -157,7 +158,8 @@ def main(argv: list[str] | None = None) -> dict:
     for spec in args.runs:
         path, kernel = spec.split(":", 1)
         run = json.loads((DATA / path if not Path(path).is_absolute() else Path(path)).read_text(encoding="utf-8"))
-        table[run["suite"]] = {name: f1(scored(run, kernel, **opts)) for name, opts in variants().items()}
+        suite = recorded_suite(run, path)
+        table[run["suite"]] = {name: f1(scored(run, suite, kernel, **opts)) for name, opts in variants().items()}
     names = list(variants())
     print("suite".ljust(12) + "".join(n.rjust(17) for n in names))
     for suite, row in table.items():

@@ -117,9 +117,9 @@ def merge(results: list[dict]) -> dict:
                 raise SystemExit(f"cannot merge runs with different {k}: {first.get(k)!r} and {r.get(k)!r}")
         if (r.get("lm") or {}).get("model_sha256") != (first.get("lm") or {}).get("model_sha256"):
             raise SystemExit("cannot merge runs made with different LM model files")
+    own = ("command", "git", "code_version", "seconds")
     out = {**first, "runs": {}, "suites": {}, "failures": [], "seconds": 0.0,
-           "parts": [p for r in results
-                     for p in (r.get("parts") or [{k: r.get(k) for k in ("command", "git", "code_version", "seconds")}])]}
+           "parts": [p for r in results for p in (r.get("parts") or [{k: r.get(k) for k in own}])]}
     for r in results:
         out["runs"].update(r["runs"])
         out["suites"].update(r["suites"])

@@ -791,8 +791,9 @@ class ExpectedErrorPolicy(QueryPolicy):
     can use answers re-scores the scene, ``gift-prob`` without an LM call), and the expected mistakes left,
     ``Σ_j min(b_j, 1 - b_j)`` over the objects not asked before (``b``: :meth:`QueryState.belief` of the state after
     the answer; the asked object counts 0), are averaged with weights ``p`` and ``1 - p`` (``p``: its belief now).
-    Priority: the reduction against now; objects outside the ``width`` nearest rank below every evaluated one. Without re-scoring (answers only fix their object and the cut stays) the reduction is the asked
-    object's own ``min(p, 1 - p)``, which ranks as ``uncertainty``. Cost: ``2 * width`` resolves per question."""
+    Priority: the reduction against now; objects outside the ``width`` nearest rank below every evaluated one.
+    Without re-scoring (answers only fix their object and the cut stays) the reduction is the asked object's own
+    ``min(p, 1 - p)``, which ranks as ``uncertainty``. Cost: ``2 * width`` resolves per question."""
 
     name: ClassVar[str] = "expected-error"
 
@@ -803,19 +804,20 @@ class ExpectedErrorPolicy(QueryPolicy):
 
     def priority(self, state: QueryState, rng: np.random.Generator) -> np.ndarray:
         open_ = ~state.asked
+
+        def mistakes(b: np.ndarray) -> float:  # expected wrong decisions among the objects open now
+            return float(np.minimum(b, 1.0 - b)[open_].sum())
+
         p = state.belief()
-        now = float(np.minimum(p, 1.0 - p)[open_].sum())
+        now = mistakes(p)
         dist = np.abs(state.scores.decision - state.cut)
         idx = np.flatnonzero(open_)
         idx = idx[np.lexsort((idx, np.round(dist[idx], 12)))][: self.width]
         out = np.full(len(state.test), -1.0 - len(state.test))  # below any reduction (each is >= -n_test / 2)
         for i in idx:
-            left = []
-            for said in (True, False):
-                after = resolve(state.problem, state.answers + (Answer(state.test[i], said),))
-                b = after.belief()
-                left.append(float(np.minimum(b, 1.0 - b)[open_].sum()))
-            out[i] = now - (p[i] * left[0] + (1.0 - p[i]) * left[1])
+            yes, no = (mistakes(resolve(state.problem, state.answers + (Answer(state.test[i], said),)).belief())
+                       for said in (True, False))
+            out[i] = now - (p[i] * yes + (1.0 - p[i]) * no)
         return out
 
 

@@ -101,7 +101,8 @@ def gift_register_alignment_operators(register: Register) -> None:
 @hookspec
 def gift_register_query_policies(register: Register) -> None:
     """Register :class:`gift.core.interfaces.QueryPolicy` factories: which test object to ask the human
-    about next (``uncertainty``, ``disagreement``, ``error-bound``, ``expected-error``, ``random``; :mod:`gift.core.queries`)."""
+    about next (``uncertainty``, ``disagreement``, ``error-bound``, ``expected-error``, ``random``;
+    :mod:`gift.core.queries`)."""
 
 
 @hookspec

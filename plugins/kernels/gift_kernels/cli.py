@@ -45,7 +45,8 @@ def configure_align(p: argparse.ArgumentParser) -> None:
                    help="ask on the terminal about up to N test objects (saved answers count; a rerun does not ask "
                         "again) and re-score with the answers")
     p.add_argument("--policy", default="uncertainty", metavar="NAME",
-                   help="which objects to ask about: uncertainty (default), disagreement, error-bound, expected-error, random")
+                   help="which objects to ask about: uncertainty (default), disagreement, error-bound, "
+                        "expected-error, random")
     p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
                    help="flag instead of decide the objects within BAND of the cut (dropped like a distractor)")
     p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
