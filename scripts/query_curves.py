@@ -79,7 +79,8 @@ def run(args: argparse.Namespace) -> dict:
             if not data:
                 continue
             sim = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid, policies=args.policies,
-                              rescore=args.rescore, move=args.move, choose=args.choose)
+                              rescore=args.rescore, move=args.move, choose=args.choose,
+                              rescore_when=args.rescore_when)
             if args.rescore:  # the same sessions with answers that only re-threshold, for the comparison
                 sim["without_rescore"] = qc.simulate(data, random_seeds=args.random_seeds, grid=args.grid,
                                                      policies=args.policies, bands=(), move=args.move,
@@ -100,6 +101,7 @@ def run(args: argparse.Namespace) -> dict:
     out["rescore"] = bool(args.rescore)
     out["move"] = args.move
     out["choose"] = args.choose
+    out["rescore_when"] = args.rescore_when
     out["seconds"] = round(time.perf_counter() - t_all, 1)
     return out
 
@@ -110,11 +112,16 @@ def merge(results: list[dict]) -> dict:
     that is itself merged contributes its own parts, so a page merged again still names every run's commit).
     Runs of different recipes (kernel, re-scoring, LM model file) are refused."""
     first = results[0]
-    keys = ("kernel", "rescore", "random_seeds", "move", "choose")
+    keys = ("kernel", "rescore", "random_seeds", "move", "choose", "rescore_when")
+    before = {"rescore_when": "always"}  # runs saved before the key existed
+
+    def value(r: dict, k: str):
+        return r.get(k, before.get(k))
+
     for r in results[1:]:
         for k in keys:
-            if r.get(k) != first.get(k):
-                raise SystemExit(f"cannot merge runs with different {k}: {first.get(k)!r} and {r.get(k)!r}")
+            if value(r, k) != value(first, k):
+                raise SystemExit(f"cannot merge runs with different {k}: {value(first, k)!r} and {value(r, k)!r}")
         if (r.get("lm") or {}).get("model_sha256") != (first.get("lm") or {}).get("model_sha256"):
             raise SystemExit("cannot merge runs made with different LM model files")
     own = ("command", "git", "code_version", "seconds")
@@ -199,7 +206,10 @@ def write(result: dict, md: Path) -> None:
                  "the kernel scores the scene again with the answers (`gift-prob` by default weighs the answered "
                  "objects as evidence beside the training objects, no LM call; with `rescore_with=ladder` it names "
                  "its category ladder again); each suite's table also gives the same sessions without it."
-                 if result.get("rescore") else ""), "",
+                 if result.get("rescore") else "") + (
+                 " Here a scene is re-scored only once some answer contradicts the kernel's decision without "
+                 "answers (`--rescore-when contradicted`); answers that agree only fix their objects."
+                 if result.get("rescore") and result.get("rescore_when") == "contradicted" else ""), "",
              "Command:", "", "```", result["command"], "```", "",
              provenance(result) + f", LM `{lm.get('identity', '–')}` (model sha256 "
              f"`{(lm.get('model_sha256') or '–')[:12]}`), {result['seconds']:.0f} s. Suites: " +
@@ -373,7 +383,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default="docs/results/queries.md")
     p.add_argument("--grid", default=",".join(map(str, qc_grid())), help="questions per intent, must include 2")
     p.add_argument("--policies", default="uncertainty,disagreement,error-bound", help="besides random")
-    from gift.core.queries import CHOOSE, DEFAULT_CHOOSE, DEFAULT_MOVE, MOVES
+    from gift.core.queries import CHOOSE, DEFAULT_CHOOSE, DEFAULT_MOVE, DEFAULT_RESCORE_WHEN, MOVES, RESCORE_WHEN
 
     p.add_argument("--move", default=DEFAULT_MOVE, choices=MOVES,
                    help="how answers move the train-calibrated cut (gift.core.queries.MOVES)")
@@ -384,6 +394,9 @@ def main(argv: list[str] | None = None) -> int:
                         "gift.core.queries; the default, as everywhere answers are used: gift-prob weighs them as "
                         "evidence, no LM call; the curves without it are kept next to them); --no-rescore: answers "
                         "only re-threshold the first scores")
+    p.add_argument("--rescore-when", default=DEFAULT_RESCORE_WHEN, choices=RESCORE_WHEN,
+                   help="with --rescore: re-score each time the answers grow (always) or only once some answer "
+                        "contradicts the kernel's decision without answers (contradicted; rule 5 of gift.core.queries)")
     p.add_argument("--from-json", nargs="+", default=None, metavar="CURVES_JSON",
                    help="write --out from saved curves.json files (their runs merged, nothing recomputed): one page "
                         "from runs made in separate processes")

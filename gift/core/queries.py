@@ -119,6 +119,12 @@ DEFAULT_MOVE = "stay"
 CHOOSE = ("primary", "answers")
 #: The default of :data:`CHOOSE` (docs/results/queries.md, "The kernel's own candidate decides").
 DEFAULT_CHOOSE = "primary"
+#: When a problem with a ``rescore`` scores the scene again (rule 5): ``always`` (the default: each time the set
+#: of "yes"/"no" answers grows) or ``contradicted`` (only once some answer contradicts the kernel's own decision
+#: without answers; answers that agree with it only fix their objects, rule 1).
+RESCORE_WHEN = ("always", "contradicted")
+#: The default of :data:`RESCORE_WHEN`.
+DEFAULT_RESCORE_WHEN = "always"
 
 
 # ============================================================================= answers
@@ -244,6 +250,11 @@ def _check_choose(inst: Any, attribute: attrs.Attribute, value: str) -> None:
         raise GiftError(f"unknown candidate choice {value!r}; one of {CHOOSE}")
 
 
+def _check_rescore_when(inst: Any, attribute: attrs.Attribute, value: str) -> None:
+    if value not in RESCORE_WHEN:
+        raise GiftError(f"unknown rescore_when {value!r}; one of {RESCORE_WHEN}")
+
+
 def _check_band(inst: Any, attribute: attrs.Attribute, value: float) -> None:
     if not 0.0 <= float(value) <= 1.0:
         raise GiftError(f"the abstention band must be in [0, 1] (distance to the cut on the decision scale), "
@@ -318,7 +329,7 @@ class QueryProblem:
     ``move``: how answers move the train-calibrated cut (:data:`MOVES`, rule 2); ``rescore``: ``answers
     (object -> bool) -> AlignmentScores | None``, the scene scored again with the answers (rule 5;
     :func:`kernel_rescorer`), None: answers only re-threshold; ``choose``: which candidate decides after
-    answers (:data:`CHOOSE`, rule 3).
+    answers (:data:`CHOOSE`, rule 3); ``rescore_when``: when ``rescore`` is called (:data:`RESCORE_WHEN`, rule 5).
     """
 
     candidates: Mapping[str, AlignmentScores] = attrs.field(converter=dict)
@@ -330,6 +341,7 @@ class QueryProblem:
     move: str = attrs.field(default=DEFAULT_MOVE, validator=_check_move)
     rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = attrs.field(default=None, eq=False)
     choose: str = attrs.field(default=DEFAULT_CHOOSE, validator=_check_choose, kw_only=True)
+    rescore_when: str = attrs.field(default=DEFAULT_RESCORE_WHEN, validator=_check_rescore_when, kw_only=True)
     _rescored: dict = attrs.field(factory=dict, init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
@@ -353,7 +365,7 @@ class QueryProblem:
            candidates: Mapping[str, AlignmentScores] | None = None, trajectories: Sequence[FeatureBatch] = (),
            lipschitz: float = 1.0, abstain: float = 0.0, test_labels: Mapping[str, bool] | None = None,
            move: str = DEFAULT_MOVE, rescore: Callable[[Mapping[str, bool]], AlignmentScores | None] | None = None,
-           choose: str = DEFAULT_CHOOSE) -> "QueryProblem":
+           choose: str = DEFAULT_CHOOSE, rescore_when: str = DEFAULT_RESCORE_WHEN) -> "QueryProblem":
         """The problem of one scene: ``scores`` (the kernel's own intent, named :data:`PRIMARY`), then
         ``candidates`` (other intents' scores of the same scene), then the candidates the kernel reported
         in ``scores.details["candidates"]``."""
@@ -362,14 +374,15 @@ class QueryProblem:
             if name in cands:
                 raise GiftError(f"two intent candidates are named {name!r}")
             cands[name] = s
-        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move, rescore, choose=choose)
+        return cls(cands, strategy, tuple(trajectories), lipschitz, abstain, test_labels, move, rescore, choose=choose,
+                   rescore_when=rescore_when)
 
     def candidates_for(self, answers: Sequence[Answer]) -> Mapping[str, AlignmentScores]:
         """The candidates that decide a scene with ``answers`` (rule 5): :attr:`candidates`, or, when the
         problem can re-score and some answer is a "yes" or "no", the re-scored scene (as :data:`PRIMARY`)
         and the views it reports (kept per set of answers)."""
         known = tuple(sorted((a.object, bool(a.relevant)) for a in answers if a.relevant is not None))
-        if self.rescore is None or not known:
+        if self.rescore is None or not known or (self.rescore_when == "contradicted" and not self.contradicted(known)):
             return self.candidates
         if known not in self._rescored:
             new = self.rescore(dict(known))
@@ -382,6 +395,13 @@ class QueryProblem:
                                     f", expected AlignmentScores of the test objects {list(self.test)}")
                 self._rescored[known] = {PRIMARY: new, **views_from_details(new, "candidates")}
         return self._rescored[known]
+
+    def contradicted(self, known: Sequence[tuple[str, bool]]) -> bool:
+        """Whether some ``(object, relevant)`` answer contradicts the first candidate's decision at its cut
+        without answers."""
+        first = next(iter(self.candidates.values()))
+        cut, _ = answered_cut(first, self.strategy, (), self.test_labels)
+        return any(bool(first.decision[self.test.index(o)] >= cut) != bool(r) for o, r in known)
 
     @property
     def test(self) -> tuple[str, ...]:

@@ -450,6 +450,26 @@ def test_rule_5_a_kernel_that_uses_answers_re_scores_the_scene_once_per_set_of_a
     assert not st.rescored and k.calls == []
 
 
+def test_rule_5_rescore_when_contradicted_re_scores_only_once_an_answer_contradicts_the_first_decisions():
+    first = {"x": 0.9, "y": 0.55, "z": 0.45, "w": 0.1}  # decided yes, yes, no, no at the cut 0.5
+    again = {"x": 0.9, "y": 0.2, "z": 0.8, "w": 0.1}
+    train = {"a": 0.8, "b": 0.7, "c": 0.3, "d": 0.2}
+    k = AnswerAware(first, train, again)
+    from gift.core.queries import kernel_rescorer
+
+    s = score_alignment(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b"))
+    p = QueryProblem.of(s, rescore=kernel_rescorer(k, objs(TEST), objs(TRAIN), relevant_train=("a", "b")),
+                        rescore_when="contradicted")
+    agree = resolve(p, [Answer("x", True), Answer("w", False)])  # both as the kernel decided: no re-scoring
+    assert not agree.rescored and k.calls == [] and agree.predicted.tolist() == [True, True, False, False]
+    assert not p.contradicted([("x", True), ("w", False)]) and p.contradicted([("z", True)])
+    st = resolve(p, [Answer("x", True), Answer("z", True)])  # z contradicts: re-scored with every answer
+    assert st.rescored and k.calls == [{"x": True, "z": True}] and st.predicted.tolist() == [True, False, True, False]
+    assert resolve(QueryProblem.of(s, rescore=p.rescore), [Answer("x", True)]).rescored  # "always", the default
+    with pytest.raises(GiftError, match="unknown rescore_when 'sometimes'"):
+        QueryProblem.of(s, rescore_when="sometimes")
+
+
 def test_expected_error_asks_the_object_whose_answer_re_scores_the_others_most_and_is_uncertainty_without_it():
     first = {"x": 0.9, "y": 0.55, "z": 0.45, "w": 0.3}
     train = {"a": 0.8, "b": 0.7, "c": 0.2, "d": 0.1}

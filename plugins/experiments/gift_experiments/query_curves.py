@@ -24,7 +24,7 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import (DEFAULT_CHOOSE, DEFAULT_MOVE, Answer, QueryProblem, QueryState, asking,
+from gift.core.queries import (DEFAULT_CHOOSE, DEFAULT_MOVE, DEFAULT_RESCORE_WHEN, Answer, QueryProblem, QueryState, asking,
                                labels_answerer, resolve)
 
 log = logging.getLogger("gift.query_curves")
@@ -102,14 +102,14 @@ def prepare(cfg: Any, suite: Any, spec: Any, cache: Any, comp: Any) -> IntentDat
 
 def session(data: IntentData, policy: str, seed: int = 0, band: float = 0.0,
             grid: Sequence[int] = K_GRID, move: str = DEFAULT_MOVE, rescore: bool = True,
-            choose: str = DEFAULT_CHOOSE) -> list[QueryState]:
+            choose: str = DEFAULT_CHOOSE, rescore_when: str = DEFAULT_RESCORE_WHEN) -> list[QueryState]:
     """The states after k questions for each k of ``grid`` (the last state when every object was asked);
     ``rescore``: the kernel scores the scene again with the answers when it can (rule 5, the default as in
     :func:`gift.core.queries.align_with_queries`; ``gift-prob`` weighs them as evidence, no LM call); False:
     answers only re-threshold."""
     trajectories = [f for f, _, _ in data.scenes] if data.scenes else []
     problem = QueryProblem.of(data.scores, THRESHOLD, trajectories=trajectories, abstain=band, move=move,
-                              rescore=data.rescore if rescore else None, choose=choose)
+                              rescore=data.rescore if rescore else None, choose=choose, rescore_when=rescore_when)
     states = list(asking(problem, policy, labels_answerer(data.labels), max(grid), seed=seed))
     return [states[min(k, len(states) - 1)] for k in grid]
 
@@ -161,11 +161,13 @@ def best_questions(data: IntentData, k: int = 2, move: str = DEFAULT_MOVE,
 
 def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequence[int] = K_GRID,
              bands: Sequence[float] = BANDS, move: str = DEFAULT_MOVE, rescore: bool = True,
-             policies: Sequence[str] = POLICIES, choose: str = DEFAULT_CHOOSE) -> dict[str, Any]:
+             policies: Sequence[str] = POLICIES, choose: str = DEFAULT_CHOOSE,
+             rescore_when: str = DEFAULT_RESCORE_WHEN) -> dict[str, Any]:
     """Every policy (and ``random`` over ``random_seeds`` seeds) at every k of ``grid`` on one suite; abstention
     at k = 0 for each band; ``move``: how answers move the cut (:data:`gift.core.queries.MOVES`); ``rescore``:
     the kernel scores each scene again with the answers where it can (rule 5); ``policies``: the policies run; ``choose``:
-    which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`). Returns
+    which intent candidate decides after answers (rule 3, :data:`gift.core.queries.CHOOSE`); ``rescore_when``: when
+    answers re-score (:data:`gift.core.queries.RESCORE_WHEN`). Returns
     ``{"grid", "curves": {policy: {...}}, "per_intent", "abstention", "bound", "rescored_intents"}``; ``bound``:
     the best 2 questions per intent chosen with the labels (:func:`best_questions`, the ceiling of any policy when
     answers only re-threshold), None when some session re-scored its scene or without 2 in the grid;
@@ -181,7 +183,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
         for seed in seeds:
             outcomes = {}
             for d in data:
-                states = session(d, policy, seed, grid=grid, move=move, rescore=rescore, choose=choose)
+                states = session(d, policy, seed, grid=grid, move=move, rescore=rescore, choose=choose,
+                                 rescore_when=rescore_when)
                 if any(st.rescored for st in states):
                     rescored.add(d.intent)
                 outcomes[d.intent] = [outcome(d, st) for st in states]
@@ -204,7 +207,8 @@ def simulate(data: Sequence[IntentData], *, random_seeds: int = 10, grid: Sequen
                               for i, runs_i in by_intent.items()}
     for policy in policies:  # which objects each deterministic policy asked about, in order, per intent
         for d in data:
-            last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore, choose=choose)[0]
+            last = session(d, policy, 0, grid=(max(grid),), move=move, rescore=rescore, choose=choose,
+                           rescore_when=rescore_when)[0]
             per_intent[policy][d.intent]["asked"] = [a.object for a in last.answers]
     bound = None
     if 2 in grid and not rescored:  # what any policy could reach with 2 questions (answers only re-threshold)
