@@ -43,6 +43,8 @@ DEV14_LABEL = {"cakes": "q1a", "bristled_things": "q1b", "flours": "q2a", "tasse
                "orienteering_kit": "q3a", "chess_kit": "q3b", "sieves": "q4a", "stamping_things": "q4b"}
 DEV15_LABEL = {"crackers": "r1a", "belled_things": "r1b", "rice": "r2a", "zipped_things": "r2b",
                "pony_grooming": "r3a", "tea_ceremony": "r3b", "spanners": "r4a", "gift_wrapping": "r4b"}
+DEV16_LABEL = {"jam": "s1a", "plaster_things": "s1b", "laundry_detergent": "s2a", "hooded_things": "s2b",
+               "archery_kit": "s3a", "soldering_kit": "s3b", "hammers": "s4a", "polishing_things": "s4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -94,7 +96,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
-                    "gift-dev15": DEV15_LABEL}
+                    "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL}
 
 
 def main() -> None:
