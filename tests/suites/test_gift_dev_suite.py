@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14`` and ``gift-dev15``: new intents and objects, none borrowed from the suites they are
-checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15`` and ``gift-dev16``: new intents and objects, none borrowed from the
+suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -182,6 +182,18 @@ DEV_SUITES = {
                        r"|ceremon|chanoyu|\bchad[oō]\b|chasen|chashaku|chawan|fukusa|kaishi|kensui|\braku\b"
                        r"|spanner|wrench|stillson|ratchet|\bsockets?\b|wheel.?brace"
                        r"|\bwrap|\bgifts?\b|\bpresents?\b|furoshiki",
+    },
+    "gift-dev16": {
+        "siblings": [("jam", "plaster_things"), ("laundry_detergent", "hooded_things"),
+                     ("archery_kit", "soldering_kit"), ("hammers", "polishing_things")],
+        "label_words": r"\bjams?\b|preserves?\b|confitur|marmalad|conserves?\b"
+                       r"|plaster|gypsum|chalkware|stucco"
+                       r"|laundry|detergent|washing.?(?:powder|liquid)|soap.?(?:flakes|nuts)"
+                       r"|\bhoods?\b|hooded|hoodie|anorak|cagoule|duffle"
+                       r"|archer|\bbows?\b|bowstring|\barrows?\b|quiver|fletch|\bnocks?\b|\btargets?\b|bracer"
+                       r"|solder|\bflux\b|\btinn(?:er|ing)\b"
+                       r"|hammer|mallet|gavel"
+                       r"|polish|\bbuff(?:s|ed|ing|er|ers)?\b|burnish",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
