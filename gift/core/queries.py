@@ -64,7 +64,9 @@ How answers update the scene (the rule)
    views it reports replace every candidate (then rules 3, 2 and 1 apply as above). ``gift-prob`` names its
    category ladder again with the "yes" objects beside the demonstrated ones and the "no" objects beside
    the left-alone ones. Re-scored scenes are kept per set of answers, and a policy's "what if" states
-   (:meth:`QueryState.assume`) re-threshold the current scores without re-scoring.
+   (:meth:`QueryState.assume`) re-threshold the current scores without re-scoring. With
+   ``rescore_when="contradicted"`` (measured, not the default: docs/results/queries.md) the scene is re-scored only
+   once some answer contradicts the first candidate's decision without answers.
 
 Intent candidates and terms a kernel reports
 --------------------------------------------
