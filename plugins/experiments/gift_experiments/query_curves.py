@@ -24,8 +24,8 @@ import numpy as np
 
 from gift.core.alignment import AlignmentScores
 from gift.core.metrics import binary_metrics, mean_se, pairwise_win_rate
-from gift.core.queries import (DEFAULT_CHOOSE, DEFAULT_MOVE, DEFAULT_RESCORE_WHEN, Answer, QueryProblem, QueryState, asking,
-                               labels_answerer, resolve)
+from gift.core.queries import (DEFAULT_CHOOSE, DEFAULT_MOVE, DEFAULT_RESCORE_WHEN, Answer, QueryProblem, QueryState,
+                               asking, labels_answerer, resolve)
 
 log = logging.getLogger("gift.query_curves")
 
