@@ -45,6 +45,8 @@ DEV15_LABEL = {"crackers": "r1a", "belled_things": "r1b", "rice": "r2a", "zipped
                "pony_grooming": "r3a", "tea_ceremony": "r3b", "spanners": "r4a", "gift_wrapping": "r4b"}
 DEV16_LABEL = {"jam": "s1a", "plaster_things": "s1b", "laundry_detergent": "s2a", "hooded_things": "s2b",
                "archery_kit": "s3a", "soldering_kit": "s3b", "hammers": "s4a", "polishing_things": "s4b"}
+DEV17_LABEL = {"stock": "t1a", "prayer_things": "t1b", "nightwear": "t2a", "dyeing_things": "t2b",
+               "surfing_kit": "t3a", "tiling_kit": "t3b", "clamps": "t4a", "pocketed_things": "t4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -96,7 +98,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
-                    "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL}
+                    "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL}
 
 
 def main() -> None:
