@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14``, ``gift-dev15`` and ``gift-dev16``: new intents and objects, none borrowed from the
-suites they are checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16`` and ``gift-dev17``: new intents and objects, none
+borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -194,6 +194,19 @@ DEV_SUITES = {
                        r"|solder|\bflux\b|\btinn(?:er|ing)\b"
                        r"|hammer|mallet|gavel"
                        r"|polish|\bbuff(?:s|ed|ing|er|ers)?\b|burnish",
+    },
+    "gift-dev17": {
+        "siblings": [("stock", "prayer_things"), ("nightwear", "dyeing_things"),
+                     ("surfing_kit", "tiling_kit"), ("clamps", "pocketed_things")],
+        "label_words": r"\bstocks?\b|bouillon|\bbroths?\b|consomm|\bdashi\b|\boxo\b"
+                       r"|\bpray|rosar|\bmalas?\b|tasbih|misbaha|komboskini|tallit|tefillin|worship|devotion"
+                       r"|pyjama|pajama|\bpjs?\b|nightwear|sleepwear|nightdress|nightie|nightgown|nightshirt|negligee"
+                       r"|jim.?jams"
+                       r"|\bdy(?:e|es|ed|eing|er|ers)\b|dyestuff|mordant|\bhenna\b|indigo|\bwoad\b|madder|cochineal"
+                       r"|\bsurf(?:s|er|ers|ing|board|boards)?\b|\bwaves?\b|wetsuit"
+                       r"|\btil(?:e|es|ed|er|ers|ing)\b|grout|thinset|mosaic"
+                       r"|\bclamp|\bcramps?\b|\bvices?\b|\bvises?\b|handscrew"
+                       r"|\bpocket",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
