@@ -27,7 +27,6 @@ log = logging.getLogger("name_gap_probe")
 
 def rows_of(path: str, kernel) -> list[dict]:
     import gift
-    from gift.core.data import Intent
     from gift_kernels import prompts
 
     d = json.loads(open(path, encoding="utf-8").read())
@@ -43,7 +42,7 @@ def rows_of(path: str, kernel) -> list[dict]:
         w = np.asarray((lad.get("check") or {}).get("weights") or [1.0] * len(cats), dtype=float)
         if w.size != len(cats) or w.sum() <= 0:
             w = np.ones(len(cats))
-        goal = Intent(text=it["intent_text"], source="inferred").text
+        goal = it["intent_text"]
         cut = float(it["thresholds"]["train-calibrated"]["cut"])
         for o in suite.specs(spec.test_objects):
             lo = {text: np.array([kernel._ask(prompts.relevance_messages(o, goal, kernel.template,

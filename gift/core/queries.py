@@ -398,12 +398,15 @@ class QueryProblem:
                 self._rescored[known] = {PRIMARY: new, **views_from_details(new, "candidates")}
         return self._rescored[known]
 
+    def wrong_answers(self, scores: AlignmentScores, known: Sequence[tuple[str, bool]]) -> int:
+        """How many ``(object, relevant)`` answers contradict ``scores``' own decisions at its cut without answers."""
+        cut, _ = answered_cut(scores, self.strategy, (), self.test_labels)
+        return sum(bool(scores.decision[self.test.index(o)] >= cut) != bool(r) for o, r in known)
+
     def contradicted(self, known: Sequence[tuple[str, bool]]) -> bool:
         """Whether some ``(object, relevant)`` answer contradicts the first candidate's decision at its cut
         without answers."""
-        first = next(iter(self.candidates.values()))
-        cut, _ = answered_cut(first, self.strategy, (), self.test_labels)
-        return any(bool(first.decision[self.test.index(o)] >= cut) != bool(r) for o, r in known)
+        return self.wrong_answers(next(iter(self.candidates.values())), known) > 0
 
     @property
     def test(self) -> tuple[str, ...]:
@@ -627,8 +630,7 @@ def resolve(problem: QueryProblem, answers: Sequence[Answer] = (), *,
     # answered objects wrong (choose="answers"; ties: the earlier); mistakes are counted for reports either way
     mistakes = {}
     for name, s in cands.items():
-        cut0, _ = answered_cut(s, problem.strategy, (), problem.test_labels)
-        mistakes[name] = sum(bool(s.decision[test.index(a.object)] >= cut0) != a.relevant for a in known)
+        mistakes[name] = problem.wrong_answers(s, [(a.object, bool(a.relevant)) for a in known])
     order = list(cands)
     chosen = min(order, key=lambda n: (mistakes[n], order.index(n))) if problem.choose == "answers" else order[0]
     scores = cands[chosen]
