@@ -30,7 +30,9 @@ The procedure, per role:
      whole, against the range of its default trajectories (which differ only by that noise): an object is
      *avoided* when every preferred trajectory stayed further from it than every default trajectory did,
      *approached* in the opposite case; each pair's choice is the avoided object whose closeness it cut
-     by the largest fraction.
+     by the largest fraction. Pair by pair, the model also counts which objects each preferred trajectory
+     kept further from than every default did (:func:`pair_avoidance`): a second relevant object, avoided
+     in every pair but never the one a pair steered by most, shows there.
 
    A scene carries no evidence when the human never deviates (they did what the default does), and a
    deviation in the mode's direction on every object of the scene (e.g. a carry raised over the whole
@@ -41,14 +43,17 @@ The procedure, per role:
    passing, no object of R was approached); the human's preferences among those objects are unknown, a
    Dirichlet-multinomial with a flat prior, so an object of R that is present but never chosen costs
    likelihood. Outlier: the choices are arbitrary among all the scene's objects. The outlier rate ε has a
-   flat prior on [0, 1] and is integrated out. Every subset R of the observed objects is scored under a
+   flat prior on [0, 1] and is integrated out. Passing roles add, per scene, the pairs' avoidances: each
+   relevant object the defaults pass is avoided at one rate p, each irrelevant one (incidentally, beside a
+   relevant one) at a rate q <= p, flat prior on the ordered pair, both integrated out. Every subset R of the observed objects is scored under a
    flat prior over subsets, which gives each object's posterior probability of being relevant.
 5. **The cut.** An object is relevant when its posterior exceeds 1/2, the decision that minimises the
    expected number of misclassified objects. Nothing is tuned: the only numbers are the flat priors. A lower
-   cut was tried (0.35, 2026-12-05; ``docs/results/front_half.md`` section 30): a second relevant object that is
-   nobody's choice (the human always steered by the first one beside it) keeps a posterior near the prior, and
-   at the reproduce sizes no irrelevant object's posterior exceeded 0.24 on 17 suites; but with fewer
-   demonstrations perturbation noise puts irrelevant objects in the same band, so it was reverted.
+   cut was tried (0.35, 2026-12-05; ``docs/results/front_half.md`` section 30) for a second relevant object
+   that is nobody's choice (the human always steered by the first one beside it), which the choices alone
+   leave near the prior; but with fewer demonstrations perturbation noise puts irrelevant objects in the same
+   band (an acting family at two scenes of three pairs), so it was reverted. The pairs' avoidances (step 4)
+   are what now tells that second object apart (section 32).
 
 Edge cases:
 
@@ -169,11 +174,15 @@ class RelevantObjects:
 @attrs.frozen
 class _Unit:
     """One scene's evidence for one role: ``present`` objects, ``counts`` ``[n]`` of the human's choices, and
-    (passing) the ``approached`` objects; indices are positions in the observed-object list."""
+    (passing) the ``approached`` objects and, per object ``[n]``, the pairs that ``avoided`` it of the
+    ``trials`` that could have (see :func:`pair_avoidance`); indices are positions in the observed-object
+    list."""
 
     present: tuple[int, ...]
     counts: np.ndarray
     approached: tuple[int, ...] = ()
+    avoided: np.ndarray | None = None
+    trials: np.ndarray | None = None
 
 
 def _role_key(spec: FeatureSpec) -> str:
@@ -252,7 +261,56 @@ def passing_choices(pref: np.ndarray, default: np.ndarray) -> tuple[np.ndarray, 
     return avoided, approached, choices
 
 
+def pair_avoidance(pref: np.ndarray, default: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Passing role: how often each object was avoided, pair by pair.
+
+    ``pref`` ``[n_p, k]``, ``default`` ``[n_d, k]`` as in :func:`passing_choices`. A pair avoided an object
+    when its preferred trajectory stayed further from it than every default trajectory of the scene. An
+    object the defaults never come near (summed closeness 0) cannot be avoided and counts no trial.
+    Returns ``(avoided [k], trials [k])``: pairs that avoided each object, pairs that could have.
+    """
+    reachable = default.min(axis=0) > _TOL
+    hit = (pref < default.min(axis=0)[None, :] - _TOL) & reachable[None, :]
+    return hit.sum(axis=0).astype(float), np.where(reachable, float(len(pref)), 0.0)
+
+
 # ----------------------------------------------------------------------------- likelihood over relevant sets
+
+
+def _lbeta(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    lgamma = np.vectorize(math.lgamma, otypes=[float])
+    return lgamma(a) + lgamma(b) - lgamma(a + b)
+
+
+def _log_two_rates(a: int, b: int, c: int, d: int) -> float:
+    """log ∫∫_{p>q} 2 p^a (1-p)^b q^c (1-q)^d dq dp: ``a`` avoidances and ``b`` non-avoidances of relevant
+    objects at rate p, ``c`` and ``d`` of irrelevant ones at rate q <= p (flat prior on the ordered pair).
+
+    Exact, as a sum of positive terms: ∫_0^p q^c (1-q)^d dq = B(c+1, d+1) Σ_{j>c}^{N} C(N, j) p^j (1-p)^(N-j)
+    with N = c + d + 1, and each term integrates against p^a (1-p)^b to a beta function.
+    """
+    n = c + d + 1
+    j = np.arange(c + 1, n + 1, dtype=float)
+    log_binom = math.lgamma(n + 1.0) - np.vectorize(math.lgamma)(j + 1.0) - np.vectorize(math.lgamma)(n - j + 1.0)
+    terms = log_binom + _lbeta(a + j + 1.0, b + n - j + 1.0)
+    return math.log(2.0) + float(_lbeta(np.array(c + 1.0), np.array(d + 1.0))) + float(np.logaddexp.reduce(terms))
+
+
+def _avoidance_loglik(u: _Unit, bits: np.ndarray) -> np.ndarray | None:
+    """log P(which pairs avoided which objects | R) ``[M]`` of one passing scene, or None without trials.
+
+    Every relevant object the defaults pass is avoided at one rate p, every irrelevant one (incidentally,
+    e.g. beside a relevant one) at a rate q <= p; p and q are integrated out. A second relevant object that
+    is never the pair's main choice still shows here.
+    """
+    if u.trials is None or not u.trials.any():
+        return None
+    av = u.avoided.astype(int)
+    no = (u.trials - u.avoided).astype(int)
+    stats = np.stack([bits @ av, bits @ no, (~bits) @ av, (~bits) @ no], axis=1)    # [M, 4]
+    keys, inverse = np.unique(stats, axis=0, return_inverse=True)
+    values = np.array([_log_two_rates(*map(int, k)) for k in keys])
+    return values[np.ravel(inverse)]
 
 
 def _log_dirmult(counts: np.ndarray, k: np.ndarray) -> np.ndarray:
@@ -302,6 +360,9 @@ def _posterior(units: Sequence[_Unit], n_objects: int) -> tuple[np.ndarray, int]
         log_b, log_a = ll
         with np.errstate(divide="ignore"):
             total += np.logaddexp(np.log1p(-eps)[None, :] + log_b[:, None], np.log(eps)[None, :] + log_a)
+        av = _avoidance_loglik(u, bits)
+        if av is not None:
+            total += av[:, None]
     log_l = np.logaddexp.reduce(total + log_w[None, :], axis=1)                  # [M]
     post = np.exp(log_l - np.logaddexp.reduce(log_l))
     return np.clip(post @ bits, 0.0, 1.0), informative
@@ -402,19 +463,22 @@ def infer_relevant_objects(pairs: Sequence[DemonstrationPair], train_objects: Se
             at = tuple(local[j] for j in objs_here)
             counts = np.zeros(len(observed))
             approached: tuple[int, ...] = ()
+            hits = trials = None
             if mode == "acting":
                 w = acting_choices(ap, ad).sum(axis=0)
             else:
                 avoided, near, choices = passing_choices(ap, ad)
                 w = choices.sum(axis=0)
                 approached = tuple(k for k, b in zip(at, near) if b)
+                hits, trials = np.zeros(len(observed)), np.zeros(len(observed))
+                hits[list(at)], trials[list(at)] = pair_avoidance(ap, ad)
                 for j, a, b in zip(objs_here, avoided, near):
                     ev[names[j]]["avoided"] += int(a)
                     ev[names[j]]["approached"] += int(b)
             counts[list(at)] = w
             for j, c in zip(objs_here, w):
                 ev[names[j]]["chosen"] += float(c)
-            units.append(_Unit(at, counts, approached))
+            units.append(_Unit(at, counts, approached, hits, trials))
 
     post, informative = _posterior(units, len(observed)) if observed else (np.zeros(0), 0)
     scores = {names[j]: float(post[k]) for k, j in enumerate(observed)}

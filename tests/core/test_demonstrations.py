@@ -108,31 +108,33 @@ def test_the_scenes_ground_truth_field_is_never_read():
     assert a.relevant == b.relevant and a.scores == b.scores
 
 
-def test_below_one_half_weak_evidence_and_noise_look_alike():
-    """Why the cut stays at 1/2 (module docstring, step 5). Passing family: wherever ruby is, the human steers by
-    ruby, so opal beside it is nobody's choice. With two pairs in the one scene without ruby, steering clear of
-    opal leaves it under 1/2 (missed); steering by nothing there puts an irrelevant object at the same height."""
+def test_a_second_relevant_object_avoided_beside_the_first_is_relevant():
+    """Passing family: wherever ruby is, the human steers by ruby, so opal beside it is never a pair's choice.
+    Kept further from opal in every pair too, opal is relevant (the pairs' avoidances, module docstring step
+    4); passed as close as the default beside ruby, it is not, and no irrelevant object rises with it."""
     specs = passing_specs()
     layouts = [("ruby", "opal", "brick", "cork"), ("ruby", "opal", "nail", "rope"), ("ruby", "cork", "rope", "brick"),
                ("opal", "brick", "nail", "rope")]
 
-    def infer(opal_avoided: bool):
+    def infer(opal_beside_ruby: float):
         rng = np.random.default_rng(0)
         pairs = []
         for k, names in enumerate(layouts):
             base = {o: 1.0 for o in names}
-            steered = {**base, "ruby": 0.4} if "ruby" in names else {**base, "opal": 0.7 if opal_avoided else 1.0}
+            steered = ({**base, "ruby": 0.4, **({"opal": opal_beside_ruby} if "opal" in names else {})}
+                       if "ruby" in names else {**base, "opal": 0.7})
             for _ in range(6 if "ruby" in names else 2):
                 pairs.append(DemonstrationPair(passing_trace(specs, list(names), steered, rng),
                                                passing_trace(specs, list(names), base, rng), scene(names, k)))
         return infer_relevant_objects(pairs, OBJECTS)
 
-    weak, noise = infer(True), infer(False)
-    assert weak.modes == noise.modes == {"proximity:cart": "passing"}
-    assert 0.35 < weak.scores["opal"] < CUT and weak.relevant == ("ruby",)
-    impostor = max((o for o in OBJECTS if o not in RELEVANT), key=noise.scores.get)
-    assert 0.35 < noise.scores[impostor] < CUT and noise.relevant == ("ruby",)
-
+    both, one = infer(0.8), infer(1.0)
+    assert both.modes == one.modes == {"proximity:cart": "passing"}
+    assert both.evidence["opal"].chosen <= 2 < both.evidence["ruby"].chosen
+    assert both.relevant == ("ruby", "opal") and both.scores["opal"] > 0.95
+    assert one.relevant == ("ruby",) and one.scores["opal"] < 0.05
+    for res in (both, one):
+        assert max(res.scores[o] for o in OBJECTS if o not in RELEVANT) < 0.05
 
 def test_the_cut_is_one_half_of_the_posterior():
     res = infer_relevant_objects(acting_pairs(LAYOUTS[:2], n=2, seed=3), OBJECTS)
@@ -257,3 +259,23 @@ def test_more_objects_than_the_exhaustive_model_handles_is_a_clear_error():
     layouts = [objs[i:i + 5] for i in range(0, len(objs) - 4, 4)] + [objs[-5:]]
     with pytest.raises(ValidationError, match=f"at most {MAX_OBJECTS}"):
         infer_relevant_objects(acting_pairs(layouts, relevant=objs[:2], n=1, specs=acting_specs(objs)), objs)
+
+
+@pytest.mark.parametrize("a,b,c,d", [(0, 0, 0, 0), (5, 0, 1, 7), (0, 6, 6, 0), (12, 3, 2, 20)])
+def test_the_two_rate_integral_is_exact(a, b, c, d):
+    """``_log_two_rates``: 2 ∫∫_{p>q} p^a (1-p)^b q^c (1-q)^d against a fine midpoint grid."""
+    from gift.core.demonstrations import _log_two_rates
+
+    g = (np.arange(4000) + 0.5) / 4000
+    p, q = np.meshgrid(g, g, indexing="ij")
+    grid = 2 * np.sum(np.where(p > q, p ** a * (1 - p) ** b * q ** c * (1 - q) ** d, 0.0)) / g.size ** 2
+    assert _log_two_rates(a, b, c, d) == pytest.approx(np.log(grid), abs=2e-3)
+
+
+def test_pair_avoidance_counts_pairs_and_skips_objects_the_defaults_never_pass():
+    from gift.core.demonstrations import pair_avoidance
+
+    default = np.array([[1.0, 1.0, 0.0], [1.1, 0.9, 0.0]])
+    pref = np.array([[0.5, 0.95, 0.0], [0.6, 0.8, 0.0], [1.2, 0.85, 0.0]])
+    avoided, trials = pair_avoidance(pref, default)
+    assert avoided.tolist() == [2.0, 2.0, 0.0] and trials.tolist() == [3.0, 3.0, 0.0]
