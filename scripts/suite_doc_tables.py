@@ -47,6 +47,8 @@ DEV16_LABEL = {"jam": "s1a", "plaster_things": "s1b", "laundry_detergent": "s2a"
                "archery_kit": "s3a", "soldering_kit": "s3b", "hammers": "s4a", "polishing_things": "s4b"}
 DEV17_LABEL = {"stock": "t1a", "prayer_things": "t1b", "nightwear": "t2a", "dyeing_things": "t2b",
                "surfing_kit": "t3a", "tiling_kit": "t3b", "clamps": "t4a", "pocketed_things": "t4b"}
+DEV18_LABEL = {"cooking_fats": "u1a", "chained_things": "u1b", "chopping_boards": "u2a", "polka_dot_things": "u2b",
+               "athletics_kit": "u3a", "spinning_kit": "u3b", "underwear": "u4a", "correcting_things": "u4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -98,7 +100,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev5": DEV5_LABEL, "gift-dev6": DEV6_LABEL, "gift-dev7": DEV7_LABEL, "gift-dev8": DEV8_LABEL,
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
-                    "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL}
+                    "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
+                    "gift-dev18": DEV18_LABEL}
 
 
 def main() -> None:
