@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16`` and ``gift-dev17``: new intents and objects, none
-borrowed from the suites they are checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17`` and ``gift-dev18``: new intents and
+objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -207,6 +207,21 @@ DEV_SUITES = {
                        r"|\btil(?:e|es|ed|er|ers|ing)\b|grout|thinset|mosaic"
                        r"|\bclamp|\bcramps?\b|\bvices?\b|\bvises?\b|handscrew"
                        r"|\bpocket",
+    },
+    "gift-dev18": {
+        "siblings": [("cooking_fats", "chained_things"), ("chopping_boards", "polka_dot_things"),
+                     ("athletics_kit", "spinning_kit"), ("underwear", "correcting_things")],
+        "label_words": r"\blard\b|dripping|\bfats?\b|\bsuet\b|\bghee\b|shortening|schmaltz|tallow|cookeen|\btrex\b"
+                       r"|\bchain"
+                       r"|\bchop|\bboards?\b|manaita|butcher.?s.?block"
+                       r"|polka|\bdots?\b|dotted|dotty|\bspots?\b|spotted|spotty"
+                       r"|athlet|\btrack\b|\brelay|\bsprint|discus|shot.?put|javelin|hurdl|\bspikes?\b|\bspiked\b"
+                       r"|\bolympi"
+                       r"|\bspin(?:s|ning|ner|ners|dle|dles)?\b|\byarns?\b|roving|\bcard(?:er|ers|ing)\b|niddy"
+                       r"|lazy.?kate|\bdistaff"
+                       r"|underwear|undergarment|underclothes|lingerie|knickers|\bbriefs?\b|\bboxers?\b|\bbras?\b"
+                       r"|\bvests?\b|long.?johns|y.?fronts|\bpants\b|\bsmalls\b|\bundies\b"
+                       r"|\beras|correct|tipp.?ex|snopake|\brub(?:bing)? out\b|mistak|white.?out",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
