@@ -45,8 +45,9 @@ The procedure, per role:
    likelihood. Outlier: the choices are arbitrary among all the scene's objects. The outlier rate ε has a
    flat prior on [0, 1] and is integrated out. Passing roles add, per scene, the pairs' avoidances: each
    relevant object the defaults pass is avoided at one rate p, each irrelevant one (incidentally, beside a
-   relevant one) at a rate q <= p, flat prior on the ordered pair, both integrated out. Every subset R of the observed objects is scored under a
-   flat prior over subsets, which gives each object's posterior probability of being relevant.
+   relevant one) at a rate q <= p, flat prior on the ordered pair, both integrated out. Every subset R of
+   the observed objects is scored under a flat prior over subsets, which gives each object's posterior
+   probability of being relevant.
 5. **The cut.** An object is relevant when its posterior exceeds 1/2, the decision that minimises the
    expected number of misclassified objects. Nothing is tuned: the only numbers are the flat priors. A lower
    cut was tried (0.35, 2026-12-05; ``docs/results/front_half.md`` section 30) for a second relevant object
@@ -485,8 +486,9 @@ def infer_relevant_objects(pairs: Sequence[DemonstrationPair], train_objects: Se
     undetermined = tuple(n for n, s in scores.items() if abs(s - 0.5) < 1e-9)
     relevant = tuple(n for n in names if scores.get(n, 0.0) > CUT and n not in undetermined)
     rule = (f"posterior P(relevant | demonstrations) under a per-scene choice model with scene outliers (flat "
-            f"priors over relevant sets and the outlier rate); relevant = posterior > {CUT}, the fewest expected "
-            f"misclassified objects. Roles: " + ", ".join(f"{r} {m}" for r, m in modes.items()) +
+            f"priors over relevant sets and the outlier rate; passing roles also count every object each pair "
+            f"avoided, relevant ones at a rate at least the others'); relevant = posterior > {CUT}, the fewest "
+            f"expected misclassified objects. Roles: " + ", ".join(f"{r} {m}" for r, m in modes.items()) +
             f". {informative} of {len(units)} scene-role units are informative.")
     if not informative:
         rule += " No scene's demonstrations single out an object: nothing is inferred."
