@@ -278,9 +278,12 @@ def pair_avoidance(pref: np.ndarray, default: np.ndarray) -> tuple[np.ndarray, n
 # ----------------------------------------------------------------------------- likelihood over relevant sets
 
 
+#: log Γ, elementwise over arrays (math.lgamma; the core does not depend on scipy).
+_lgamma = np.vectorize(math.lgamma, otypes=[float])
+
+
 def _lbeta(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    lgamma = np.vectorize(math.lgamma, otypes=[float])
-    return lgamma(a) + lgamma(b) - lgamma(a + b)
+    return _lgamma(a) + _lgamma(b) - _lgamma(a + b)
 
 
 def _log_two_rates(a: int, b: int, c: int, d: int) -> float:
@@ -292,7 +295,7 @@ def _log_two_rates(a: int, b: int, c: int, d: int) -> float:
     """
     n = c + d + 1
     j = np.arange(c + 1, n + 1, dtype=float)
-    log_binom = math.lgamma(n + 1.0) - np.vectorize(math.lgamma)(j + 1.0) - np.vectorize(math.lgamma)(n - j + 1.0)
+    log_binom = math.lgamma(n + 1.0) - _lgamma(j + 1.0) - _lgamma(n - j + 1.0)
     terms = log_binom + _lbeta(a + j + 1.0, b + n - j + 1.0)
     return math.log(2.0) + float(_lbeta(np.array(c + 1.0), np.array(d + 1.0))) + float(np.logaddexp.reduce(terms))
 
@@ -317,8 +320,7 @@ def _avoidance_loglik(u: _Unit, bits: np.ndarray) -> np.ndarray | None:
 def _log_dirmult(counts: np.ndarray, k: np.ndarray) -> np.ndarray:
     """log Dirichlet(1)-multinomial probability of a choice sequence with these nonzero ``counts`` over ``k``
     categories (vectorised in ``k``; no multinomial coefficient: the sequence is observed in order)."""
-    lgamma = np.vectorize(math.lgamma, otypes=[float])
-    return lgamma(k) - lgamma(counts.sum() + k) + float(sum(math.lgamma(c + 1.0) for c in counts))
+    return _lgamma(k) - _lgamma(counts.sum() + k) + float(sum(math.lgamma(c + 1.0) for c in counts))
 
 
 def _unit_loglik(u: _Unit, bits: np.ndarray) -> tuple[np.ndarray, float] | None:

@@ -136,6 +136,7 @@ def test_a_second_relevant_object_avoided_beside_the_first_is_relevant():
     for res in (both, one):
         assert max(res.scores[o] for o in OBJECTS if o not in RELEVANT) < 0.05
 
+
 def test_the_cut_is_one_half_of_the_posterior():
     res = infer_relevant_objects(acting_pairs(LAYOUTS[:2], n=2, seed=3), OBJECTS)
     assert res.cut == CUT == 0.5
