@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17`` and ``gift-dev18``: new intents and
-objects, none borrowed from the suites they are checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18`` and ``gift-dev19``: new
+intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -222,6 +222,21 @@ DEV_SUITES = {
                        r"|underwear|undergarment|underclothes|lingerie|knickers|\bbriefs?\b|\bboxers?\b|\bbras?\b"
                        r"|\bvests?\b|long.?johns|y.?fronts|\bpants\b|\bsmalls\b|\bundies\b"
                        r"|\beras|correct|tipp.?ex|snopake|\brub(?:bing)? out\b|mistak|white.?out",
+    },
+    "gift-dev19": {
+        "siblings": [("vinegars", "sleeved_things"), ("brassicas", "embroidered_things"),
+                     ("football_kit", "mahjong_kit"), ("plectrums", "counting_things")],
+        "label_words": r"vinegar|balsam|\baceto\b|kurozu|sarson|\bacetic|vinaigr"
+                       r"|sleeve"
+                       r"|brassic|cabbage|broccol|cauliflower|brussels|\bsprouts?\b|\bkale\b|kohlrabi|romanesco"
+                       r"|pak.?cho[iy]|bok.?cho[iy]|\bsavoy\b|cavolo|collard|calabrese|crucifer"
+                       r"|embroider|needlework|needlepoint|cross.?stitch|crewel|sampler|suzani|sashiko|otomi|tenango"
+                       r"|football|soccer|\bgoal|\bfooty\b|\bfifa\b|\bpitch(?:es)?\b|shin.?(?:pad|guard)|\bstuds?\b"
+                       r"|\bstudded\b|\bcleats?\b|\bmundial"
+                       r"|mah.?jon?gg?|\briichi\b|tenb[oō]|\bnmjl\b|\bpungs?\b|\bkongs?\b|\bchows?\b"
+                       r"|plectr|\bpicks?\b|mizrab|\bbachi\b|\btsume\b"
+                       r"|\bcount(?:s|ed|ing|ers?)?\b|\btally|abacus|abaci\b|soroban|schoty|suanpan|reckon"
+                       r"|\btot(?:s|ted|ting)? up\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
