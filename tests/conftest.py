@@ -46,6 +46,18 @@ def pytest_unconfigure(config):
         shutil.rmtree(_SESSION_CACHE, ignore_errors=True)
 
 
+@pytest.fixture(scope="session")
+def drake_franka():
+    """The ``drake-franka`` simulator, built once per test session (skips when gift-sim-drake is not installed)."""
+    import gift
+    from gift.core.errors import GiftError
+
+    try:
+        return gift.get_simulator("drake-franka")
+    except GiftError as e:  # pragma: no cover - the plugin is part of the install
+        pytest.skip(f"drake-franka unavailable: {e}")
+
+
 @pytest.fixture
 def fresh_plugins():
     """Forget loaded plugins before and after the test (for tests that change GIFT_PLUGINS etc.)."""

@@ -17,7 +17,6 @@ import pytest
 
 import gift
 from gift.core.data import Appearance, FeatureBatch, ObjectSpec
-from gift.core.errors import GiftError
 
 pytestmark = pytest.mark.drake
 
@@ -32,11 +31,8 @@ N_FEAT = 1000
 
 
 @pytest.fixture(scope="module")
-def sim():
-    try:
-        return gift.get_simulator("drake-franka")
-    except GiftError as e:  # pragma: no cover - the plugin is part of the install
-        pytest.skip(f"drake-franka unavailable: {e}")
+def sim(drake_franka):
+    return drake_franka
 
 
 @pytest.fixture(scope="module")

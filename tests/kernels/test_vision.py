@@ -7,7 +7,6 @@ import pytest
 
 import gift
 from gift.core.data import Appearance, ObjectSpec
-from gift.core.errors import UnknownComponentError
 from gift_kernels import vision
 
 pytestmark = pytest.mark.slow
@@ -48,11 +47,8 @@ def test_efficientnet_features_and_kernel_on_drawn_views():
         vision.image_features(np.zeros((2, 8, 8), dtype=np.uint8))
 
 
-def test_vision_kernel_on_drake_renders():
-    try:
-        sim = gift.get_simulator("drake-franka")
-    except UnknownComponentError:
-        pytest.skip("the drake-franka simulator (gift-sim-drake) is not installed")
+def test_vision_kernel_on_drake_renders(drake_franka):
+    sim = drake_franka
     mug = ObjectSpec("coffee mug", appearance=Appearance("cylinder", (0.04, 0.1), (0.9, 0.9, 0.9)))
     cup = ObjectSpec("paper cup", appearance=Appearance("cylinder", (0.035, 0.1), (0.95, 0.95, 0.9)))
     book = ObjectSpec("book", appearance=Appearance("box", (0.2, 0.15, 0.03), (0.2, 0.3, 0.7)))

@@ -7,7 +7,6 @@ import pytest
 
 import gift
 from gift.core.data import DISTRACTOR, Alignment
-from gift.core.errors import GiftError
 from gift.core.metrics import pairwise_win_rate
 
 pytestmark = [pytest.mark.drake, pytest.mark.slow]
@@ -17,11 +16,8 @@ RELEVANT = ("paintbrush", "sketchbook")
 
 
 @pytest.fixture(scope="module")
-def sim():
-    try:
-        return gift.get_simulator("drake-franka")
-    except GiftError as e:  # pragma: no cover - the plugin is part of the install
-        pytest.skip(f"drake-franka unavailable: {e}")
+def sim(drake_franka):
+    return drake_franka
 
 
 @pytest.fixture(scope="module")
