@@ -723,6 +723,7 @@ def test_few_shot_examples_share_no_object_and_no_kind_of_goal_with_any_shipped_
     examples += [(g, (), c) for g, c in prompts.CATEGORY_EXAMPLES]
     examples += [("", h + a, " ".join(names)) for h, a, names in prompts.LADDER_EXAMPLES]
     examples += [("", h + a, " ".join(names)) for h, a, names in prompts.FACET_EXAMPLES]
+    examples += [("", h + a, " ".join(names)) for h, a, names in prompts.PART_EXAMPLES]
     for goal, objs, category in examples:
         assert not {o.lower() for o in objs} & objects, objs
         words = set(re.findall(r"[a-z]+", f"{goal} {category}".lower())) - stop
@@ -802,6 +803,34 @@ def test_gift_prob_both_ladders_average_the_breadth_and_the_facet_rungs_without_
     assert len(rs.details["ladder"]["terms"]) == 4
     systems = [c[0][0].content for c in lm.calls]
     assert systems.count(prompts.LADDER_SYSTEM) == systems.count(prompts.FACET_SYSTEM) == 1 + len(TRAIN)
+
+
+def test_gift_prob_all_rungs_add_a_part_the_demonstrated_objects_have_from_a_third_call():
+    """rungs="all": besides the breadth and the facet calls, one part call per ladder ("things with ..."); its
+    name is one more rung, asked of the test objects and, named without each, of the training objects."""
+    base = fixed_ladder(("painting tools", "art supplies", "creative things"), ("none", "none", "things that stain"))
+
+    def answer(messages, seed):
+        if messages[0].content == prompts.PART_SYSTEM:
+            assert "What do the specially treated objects have in common?" in messages[-1].content
+            return json.dumps({"part": "things with a handle" if "paintbrush" in messages[-1].content else "none"})
+        return base(messages, seed)
+
+    lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
+    k = GiftProbKernel(lm=lm, combine="none", rungs="all")
+    rs = k.score(TEST, TRAIN, PICKED_BANANA, ("paintbrush", "sketchbook"))
+    assert rs.details["ladder"]["categories"] == ["painting tools", "art supplies", "creative things",
+                                                  "things that stain", "things with a handle"]
+    systems = [c[0][0].content for c in lm.calls]
+    assert systems.count(prompts.PART_SYSTEM) == systems.count(prompts.FACET_SYSTEM) == 1 + len(TRAIN)
+    asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
+    assert any(q.startswith("Is a crayons (") and "one of the things with a handle?" in q for q in asked)
+    # the paintbrush named without it: its sketchbook-only part call says "none", so the full ladder's part stands in
+    assert any(q.startswith("Is a paintbrush (a brush for paint) one of the things with a handle?") for q in asked)
+    assert k.ladder(["sketchbook"], ["banana", "coffee mug"]) == ("painting tools", "art supplies",
+                                                                  "creative things", "things that stain")
+    with pytest.raises(ValueError, match="handled object"):
+        prompts.part_messages([], ["banana"])
 
 
 @pytest.mark.parametrize("check", ["fit", "weight", "margin", "fit-best"])

@@ -243,7 +243,7 @@ CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
-RUNGS = ("breadth", "facets", "both")
+RUNGS = ("breadth", "facets", "both", "all")
 CHECK = ("none", "fit", "weight", "margin", "fit-best")
 #: How :meth:`GiftProbKernel.score_with_answers` uses the human's answers: ``"ladder"`` names the category ladder
 #: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
@@ -307,7 +307,8 @@ class GiftProbKernel(RelevanceKernel):
     the scene under each category alone is reported as an intent candidate that answers can pick, see
     :mod:`gift.core.queries`; ``"always"``; ``"never"``, the default with a ``calibration``), ``rungs``
     (``"both"``, the default: the ladder's rungs are three breadths of one kind and, from a second call, the
-    kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``), ``check``
+    kind, material and property the objects share, "none" dropped; ``"breadth"``; ``"facets"``; ``"all"``: those and
+    a part the objects have, from a third call), ``check``
     (``"fit"``, the default: each of the ladder's categories is first asked of the training objects as named and
     kept only if it puts every demonstrated object above every left-alone one; ``"weight"``: weighted by its
     AUC - 1/2 there; ``"margin"``: those "fit" keeps, weighted by their log-odds gap between the lowest
@@ -402,7 +403,8 @@ class GiftProbKernel(RelevanceKernel):
         #: none (:func:`gift_kernels.prompts.facet_messages`); ``"both"``, the default: the rungs of the two
         #: (two calls per ladder). Chosen on gift-dev, gift-dev2 and lm-dev by a rule written before the runs
         #: (mean inferred train-calibrated F1 0.808 -> 0.813, no suite loses; facets alone lose 0.029 on
-        #: gift-dev2); docs/results/front_half.md, section 11.
+        #: gift-dev2); docs/results/front_half.md, section 11. ``"all"``: those and, from a third call, a part
+        #: or feature the objects have ("things with a chain"; :func:`gift_kernels.prompts.part_messages`).
         self.rungs = rungs
         if check not in CHECK:
             raise GiftError(f"gift-prob: check must be one of {CHECK}, got {check!r}")
@@ -565,8 +567,8 @@ class GiftProbKernel(RelevanceKernel):
 
     def _ladder_levels(self, handled: Sequence[str], left_alone: Sequence[str] = (),
                        descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
-        """:meth:`ladder` by level (``prompts.LADDER_LEVELS`` and/or ``FACET_LEVELS``, as ``rungs`` says), levels
-        without a name, or repeating an earlier level's name, left out."""
+        """:meth:`ladder` by level (``prompts.LADDER_LEVELS``, ``FACET_LEVELS``, ``PART_LEVELS``, as ``rungs``
+        says), levels without a name, or repeating an earlier level's name, left out."""
         names: dict[str, str] = {}
         for kind in self._ladder_kinds():
             for lv, cat in self._ask_ladder(kind, handled, left_alone, descriptions).items():
@@ -575,12 +577,13 @@ class GiftProbKernel(RelevanceKernel):
         return names
 
     def _ladder_kinds(self) -> tuple[str, ...]:
-        return {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets")}[self.rungs]
+        return {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets"),
+                "all": ("breadth", "facets", "parts")}[self.rungs]
 
     def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str],
                     descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
-        """One ladder call (``kind``: ``"breadth"`` or ``"facets"``), memoized: its named levels. The objects
-        are shown with ``descriptions`` when ``ladder_text="name+description"``."""
+        """One ladder call (``kind``: ``"breadth"``, ``"facets"`` or ``"parts"``), memoized: its named levels. The
+        objects are shown with ``descriptions`` when ``ladder_text="name+description"``."""
         descriptions = None if self.ladder_text == "name" else {n: (descriptions or {}).get(n, "")
                                                                  for n in (*handled, *left_alone)}
         key = (kind, tuple(handled), tuple(left_alone), descriptions and tuple(descriptions.values()))
@@ -590,9 +593,10 @@ class GiftProbKernel(RelevanceKernel):
         from gift_llm.structured import ask_dict
 
         self.calls += 1
-        facets = kind == "facets"
-        levels = prompts.FACET_LEVELS if facets else prompts.LADDER_LEVELS
-        msgs = (prompts.facet_messages if facets else prompts.ladder_messages)(handled, left_alone, descriptions)
+        levels, ask = {"breadth": (prompts.LADDER_LEVELS, prompts.ladder_messages),
+                       "facets": (prompts.FACET_LEVELS, prompts.facet_messages),
+                       "parts": (prompts.PART_LEVELS, prompts.part_messages)}[kind]
+        msgs = ask(handled, left_alone, descriptions)
         try:
             ans = ask_dict(self.lm, msgs, temperature=0.0, max_tokens=96,
                            json_schema=schemas.ladder_schema(levels) if self.constrained else None,

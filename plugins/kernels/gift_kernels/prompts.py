@@ -275,6 +275,12 @@ LADDER_EXAMPLE_DESCRIPTIONS: dict[str, str] = {
     "bag of frozen peas": "A plastic bag of small green peas, frosted over, straight from the freezer.",
     "bread roll": "A small round loaf with a golden crust, baked that morning.",
     "oven mitt": "A thick quilted glove for taking hot dishes out of the oven.",
+    "padlock": "A heavy brass lock with a curved steel shackle that snaps shut and opens with a small key.",
+    "jewellery box with a lock": "A little lacquered wooden case lined with velvet, with a tiny keyhole in its front.",
+    "garden gloves with a wrist strap": "A pair of canvas work gloves closed at the wrist by a hook-and-loop band.",
+    "camera with a neck strap": "A compact black camera hanging from a woven band worn around the neck.",
+    "table lamp with a dimmer dial": "A ceramic lamp with a linen shade and a round knob on its cord to dim it.",
+    "radio with a tuning dial": "A small wooden-cased radio with a large round knob for finding stations.",
 }
 
 
@@ -359,6 +365,32 @@ def facet_messages(handled: Sequence[str], left_alone: Sequence[str],
     :func:`ladder_messages`."""
     return _shared_names_messages("facet_messages", FACET_SYSTEM, FACET_LEVELS, FACET_EXAMPLES, handled,
                                   left_alone, descriptions)
+
+
+#: The one level of the part rung (:func:`part_messages`): a part or feature every demonstrated object has.
+PART_LEVELS: tuple[str, ...] = ("part",)
+
+PART_SYSTEM = ("You name a part or feature that every one of a set of household objects has and the other objects "
+               'lack, as a short plural noun phrase of the form "things with ...", never one object\'s name. Reply '
+               'with one JSON object and nothing else: {"part": "..."}')
+
+#: Worked examples of the part rung, written for it before any run with it (no object and no goal word of any
+#: shipped suite; checked by a test). All name a part: with "none" among them the embedded model answered "none"
+#: for every set in a probe, so a wrong part is left to the check on the training objects (``check="fit"``).
+PART_EXAMPLES: tuple[tuple[tuple[str, ...], tuple[str, ...], tuple[str]], ...] = (
+    (("padlock", "jewellery box with a lock"), ("beach ball", "floor cushion"), ("things with a lock",)),
+    (("garden gloves with a wrist strap", "camera with a neck strap"), ("toaster", "desk lamp"),
+     ("things with a strap",)),
+    (("table lamp with a dimmer dial", "radio with a tuning dial"), ("tripod", "kettle"), ("things with a dial",)),
+)
+
+
+def part_messages(handled: Sequence[str], left_alone: Sequence[str],
+                  descriptions: Mapping[str, str] | None = None) -> tuple[Message, ...]:
+    """Ask for a part or feature ("things with ...") that the ``handled`` training objects have and the
+    ``left_alone`` ones lack (no goal text); ``descriptions`` as in :func:`ladder_messages`."""
+    return _shared_names_messages("part_messages", PART_SYSTEM, PART_LEVELS, PART_EXAMPLES, handled, left_alone,
+                                  descriptions)
 
 
 _NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
