@@ -51,6 +51,8 @@ DEV18_LABEL = {"cooking_fats": "u1a", "chained_things": "u1b", "chopping_boards"
                "athletics_kit": "u3a", "spinning_kit": "u3b", "underwear": "u4a", "correcting_things": "u4b"}
 DEV19_LABEL = {"vinegars": "v1a", "sleeved_things": "v1b", "brassicas": "v2a", "embroidered_things": "v2b",
                "football_kit": "v3a", "mahjong_kit": "v3b", "plectrums": "v4a", "counting_things": "v4b"}
+DEV20_LABEL = {"pears": "w1a", "laced_things": "w1b", "apples": "w2a", "felt_things": "w2b",
+               "volleyball_kit": "w3a", "scrabble_kit": "w3b", "bottle_stoppers": "w4a", "tuning_things": "w4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -103,7 +105,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev9": DEV9_LABEL, "gift-dev10": DEV10_LABEL, "gift-dev11": DEV11_LABEL,
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
-                    "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL}
+                    "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
+                    "gift-dev20": DEV20_LABEL}
 
 
 def main() -> None:
