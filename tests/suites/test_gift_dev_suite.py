@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18`` and ``gift-dev19``: new
-intents and objects, none borrowed from the suites they are checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19`` and
+``gift-dev20``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -237,6 +237,18 @@ DEV_SUITES = {
                        r"|plectr|\bpicks?\b|mizrab|\bbachi\b|\btsume\b"
                        r"|\bcount(?:s|ed|ing|ers?)?\b|\btally|abacus|abaci\b|soroban|schoty|suanpan|reckon"
                        r"|\btot(?:s|ted|ting)? up\b",
+    },
+    "gift-dev20": {
+        "siblings": [("pears", "laced_things"), ("apples", "felt_things"),
+                     ("volleyball_kit", "scrabble_kit"), ("bottle_stoppers", "tuning_things")],
+        "label_words": r"\bpears?\b|conference|comice|concorde|williams|anjou|\bnashi\b|\bbosc\b|packham"
+                       r"|\blac(?:e|es|ed|ing)\b|lace.?up|shoelace|\baglets?\b|eyelet"
+                       r"|\bapples?\b|pippin|\brusset\b|bramley|braeburn|granny smith|pink lady|honeycrisp"
+                       r"|golden delicious|\bfelt(?:ed|s)?\b|homburg|valenki|shyrdak"
+                       r"|volley|\blibero|mikasa"
+                       r"|scrabble|protiles?|tile.?tracking"
+                       r"|stopper|\bbungs?\b|\bcorks?\b|vacu.?vin|grolsch|flip.?top|decanter top"
+                       r"|\btun(?:e|es|ed|er|ers|ing)\b|pitch.?pipe|\bsnark\b|\ba440\b|drum.?key",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
