@@ -53,6 +53,8 @@ DEV19_LABEL = {"vinegars": "v1a", "sleeved_things": "v1b", "brassicas": "v2a", "
                "football_kit": "v3a", "mahjong_kit": "v3b", "plectrums": "v4a", "counting_things": "v4b"}
 DEV20_LABEL = {"pears": "w1a", "laced_things": "w1b", "apples": "w2a", "felt_things": "w2b",
                "volleyball_kit": "w3a", "scrabble_kit": "w3b", "bottle_stoppers": "w4a", "tuning_things": "w4b"}
+DEV21_LABEL = {"baskets": "x1a", "pleated_things": "x1b", "breakfast_cereals": "x2a", "plastic_things": "x2b",
+               "fencing_kit": "x3a", "pottery_kit": "x3b", "puzzles": "x4a", "fluff_removers": "x4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -106,7 +108,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
-                    "gift-dev20": DEV20_LABEL}
+                    "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL}
 
 
 def main() -> None:
