@@ -53,7 +53,8 @@ def _rq3_objects(spec) -> list[str]:
 @pytest.mark.parametrize("suite_name", ["gift-dev", "gift-dev2", "gift-dev3", "gift-dev4", "gift-dev5", "gift-dev6",
                                         "gift-dev7", "gift-dev8", "gift-dev9", "gift-dev10", "gift-dev11",
                                         "gift-dev12", "gift-dev13", "gift-dev14", "gift-dev15", "gift-dev16",
-                                        "gift-dev17", "gift-dev18", "gift-dev19", "gift-dev20", "gift-paper"])
+                                        "gift-dev17", "gift-dev18", "gift-dev19", "gift-dev20", "gift-dev21",
+                                        "gift-paper"])
 @pytest.mark.parametrize("robot", ["jaco", "franka"])
 def test_every_scene_of_reproduce_is_placed_with_every_action_in_reach(suite_name, robot):
     """Training, RQ1 and RQ3 scenes of every intent, picked as reproduce picks them (its seeds): each fits on

@@ -1,7 +1,7 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
-``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19`` and
-``gift-dev20``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
+``gift-dev20`` and ``gift-dev21``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -249,6 +249,18 @@ DEV_SUITES = {
                        r"|scrabble|protiles?|tile.?tracking"
                        r"|stopper|\bbungs?\b|\bcorks?\b|vacu.?vin|grolsch|flip.?top|decanter top"
                        r"|\btun(?:e|es|ed|er|ers|ing)\b|pitch.?pipe|\bsnark\b|\ba440\b|drum.?key",
+    },
+    "gift-dev21": {
+        "siblings": [("baskets", "pleated_things"), ("breakfast_cereals", "plastic_things"),
+                     ("fencing_kit", "pottery_kit"), ("puzzles", "fluff_removers")],
+        "label_words": r"basket|\bhampers?\b|wicker|\bcreels?\b|banneton|\btrugs?\b|pannier"
+                       r"|\bpleat|pliss[eé]|\bkilts?\b|concertina|accordion|\btoques?\b|\bruffs?\b"
+                       r"|cereal|muesli|granola|porridge|cornflake|\bbran\b|weetabix|cheerios|\balpen\b|breakfast"
+                       r"|plastic|\bpolymer|perspex|bakelite"
+                       r"|\bfenc|\bfoils?\b|[eé]p[eé]e|\bsabres?\b|\bsabers?\b|plastron|\blam[eé]\b"
+                       r"|potter|\bkilns?\b|\bthrow(?:n|ing)? pots?\b|ceramicist"
+                       r"|puzzl|jigsaw|tangram|\bsoma\b|hanoi|brain.?teas|\bmazes?\b"
+                       r"|\bfluff|\blint\b|\bfuzz|\bbobbl|\bpill(?:s|ing|ed)?\b|gleener|\bde-?fuzz|\bde-?pill",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
