@@ -125,6 +125,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev18", "ground-truth", F + "gift-dev18-ground-truth.json"),
     Run("gift-dev19", "inferred", F + "gift-dev19-inferred.json"),
     Run("gift-dev19", "ground-truth", F + "gift-dev19-ground-truth.json"),
+    Run("gift-dev20", "inferred", F + "gift-dev20-inferred.json"),
+    Run("gift-dev20", "ground-truth", F + "gift-dev20-ground-truth.json"),
 )
 
 
