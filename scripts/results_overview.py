@@ -84,7 +84,7 @@ RUNS: tuple[Run, ...] = (
     Run("gift-paper", "ground-truth", F + "gift-paper-default-ground-truth.json"),
     Run("lm-dev", "inferred", F + "check-margin-lm-dev-inferred.json", baselines=F + "decision-lm-dev-inferred.json"),
     Run("lm-dev", "ground-truth", F + "ladder-boundary-lm-dev-ground-truth.json", note=OLD),
-    Run("gift-dev", "inferred", F + "decision-gift-dev-inferred.json", kernel="gift-prob:check=fit", note=OLD),
+    Run("gift-dev", "inferred", F + "gift-dev-default-inferred.json"),
     Run("gift-dev", "ground-truth", F + "ladder-boundary-gift-dev-ground-truth.json", note=OLD),
     Run("gift-dev2", "inferred", F + "decision-gift-dev2-inferred.json", kernel="gift-prob:check=fit", note=OLD),
     Run("gift-dev2", "ground-truth", F + "gift-dev2-ground-truth.json", note=OLD),
