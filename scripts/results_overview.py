@@ -85,7 +85,7 @@ RUNS: tuple[Run, ...] = (
     Run("lm-dev", "inferred", F + "check-margin-lm-dev-inferred.json", baselines=F + "decision-lm-dev-inferred.json"),
     Run("lm-dev", "ground-truth", F + "ladder-boundary-lm-dev-ground-truth.json", note=OLD),
     Run("gift-dev", "inferred", F + "gift-dev-default-inferred.json"),
-    Run("gift-dev", "ground-truth", F + "ladder-boundary-gift-dev-ground-truth.json", note=OLD),
+    Run("gift-dev", "ground-truth", F + "gift-dev-default-ground-truth.json"),
     Run("gift-dev2", "inferred", F + "decision-gift-dev2-inferred.json", kernel="gift-prob:check=fit", note=OLD),
     Run("gift-dev2", "ground-truth", F + "gift-dev2-ground-truth.json", note=OLD),
     Run("gift-dev3", "inferred", F + "decision-gift-dev3-inferred.json", kernel="gift-prob:check=fit", note=OLD),
