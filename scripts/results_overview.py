@@ -94,7 +94,7 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev4", "ground-truth", F + "gift-dev4-ground-truth.json", note=OLD),
     Run("gift-dev5", "inferred", F + "gift-dev5-inferred.json", note=OLD),
     Run("gift-dev5", "ground-truth", F + "gift-dev5-ground-truth.json", note=OLD),
-    Run("gift-dev6", "inferred", F + "gift-dev6-inferred.json", note=OLD),
+    Run("gift-dev6", "inferred", F + "gift-dev6-default-inferred.json"),
     Run("gift-dev6", "ground-truth", F + "gift-dev6-ground-truth.json", note=OLD),
     Run("gift-dev7", "inferred", F + "gift-dev7-default-inferred.json"),
     Run("gift-dev7", "ground-truth", F + "gift-dev7-ground-truth.json", note=OLD7),
