@@ -95,7 +95,7 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev5", "inferred", F + "gift-dev5-inferred.json", note=OLD),
     Run("gift-dev5", "ground-truth", F + "gift-dev5-ground-truth.json", note=OLD),
     Run("gift-dev6", "inferred", F + "gift-dev6-default-inferred.json"),
-    Run("gift-dev6", "ground-truth", F + "gift-dev6-ground-truth.json", note=OLD),
+    Run("gift-dev6", "ground-truth", F + "gift-dev6-default-ground-truth.json"),
     Run("gift-dev7", "inferred", F + "gift-dev7-default-inferred.json"),
     Run("gift-dev7", "ground-truth", F + "gift-dev7-ground-truth.json", note=OLD7),
     Run("gift-dev8", "inferred", F + "gift-dev8-inferred.json", kernel="gift-prob:ask_text=both",
