@@ -26,6 +26,9 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from gift.core.metrics import BinaryMetrics
+from gift.study.sweeps import recorded_suite
+
 log = logging.getLogger("results_overview")
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "docs" / "results" / "data"
@@ -151,15 +154,13 @@ def _load(rel: str) -> dict:
     return json.loads(path.read_text(encoding="utf-8"))
 
 
-def _f1(tp: int, fp: int, fn: int) -> float:
-    return 2 * tp / (2 * tp + fp + fn) if tp else 0.0
+def _pooled(records: Sequence[Mapping], cut: str) -> BinaryMetrics:
+    """The counts of every intent's test objects (subset ``all``) summed: each test object counts once."""
+    return BinaryMetrics(*(sum(r["metrics"][cut]["all"][k] for r in records) for k in ("tp", "fp", "tn", "fn")))
 
 
-def _pooled(records: Sequence[Mapping], cut: str) -> tuple[float, tuple[int, int, int]]:
-    tp = sum(r["metrics"][cut]["all"]["tp"] for r in records)
-    fp = sum(r["metrics"][cut]["all"]["fp"] for r in records)
-    fn = sum(r["metrics"][cut]["all"]["fn"] for r in records)
-    return _f1(tp, fp, fn), (tp, fp, fn)
+def _add(metrics: Sequence[BinaryMetrics]) -> BinaryMetrics:
+    return BinaryMetrics(*(sum(getattr(m, k) for m in metrics) for k in ("tp", "fp", "tn", "fn")))
 
 
 def _build(manifest: Mapping) -> str:
@@ -175,6 +176,7 @@ def row(run: Run, default: Mapping[str, str]) -> dict:
     if (res.get("suite"), res.get("intent_source")) != (run.suite, run.source):
         raise SystemExit(f"results_overview: {run.file} holds {res.get('suite')} / {res.get('intent_source')}, "
                          f"not {run.suite} / {run.source}")
+    recorded_suite(res, run.file)  # a GiftError when the suite's file has changed since the run
     if run.kernel not in res["kernels"]:
         raise SystemExit(f"results_overview: {run.file} has no kernel {run.kernel!r} ({sorted(res['kernels'])})")
     kernel = res["kernels"][run.kernel]
@@ -187,10 +189,10 @@ def row(run: Run, default: Mapping[str, str]) -> dict:
     base_res = _load(run.baselines) if run.baselines else res
     base = {b: base_res["kernels"][b]["intents"] for b in BASELINES if b in base_res["kernels"]}
     recs = list(intents.values())
-    f1, _ = _pooled(recs, TC)
-    oracle, _ = _pooled(recs, OR)
+    counts = _pooled(recs, TC)
     aucs = [r["metrics"][TC]["all"]["auc"] for r in recs if r["metrics"][TC]["all"]["auc"] is not None]
-    base_f1 = {b: _pooled([v[i] for i in intents], TC)[0] for b, v in base.items() if set(intents) <= set(v)}
+    base_counts = {b: _pooled([v[i] for i in intents], TC) for b, v in base.items() if set(intents) <= set(v)}
+    base_f1 = {b: c.f1 for b, c in base_counts.items()}
     above = level = 0
     for iid, rec in intents.items():
         best = max((v[iid]["metrics"][TC]["all"]["f1"] for v in base.values() if iid in v), default=None)
@@ -211,12 +213,12 @@ def row(run: Run, default: Mapping[str, str]) -> dict:
     started = ((man.get("runs") or [{}])[0].get("started") or "")[:10]
     best_base = max(base_f1.values()) if base_f1 else None
     base_commit = ((base_res.get("manifest") or {}).get("git") or {}).get("commit", "")[:7]
-    return {"suite": run.suite, "source": run.source, "intents": len(intents), "f1": f1, "oracle": oracle,
-            "auc": float(np.mean(aucs)) if aucs else None, "baselines": base_f1, "best_base": best_base,
-            "above": above, "level": level, "counts": _pooled(recs, TC)[1],
-            "base_counts": {b: _pooled([v[i] for i in intents], TC)[1] for b, v in base.items()
-                            if set(intents) <= set(v)},
+    return {"suite": run.suite, "source": run.source, "intents": len(intents), "f1": counts.f1,
+            "oracle": _pooled(recs, OR).f1, "auc": float(np.mean(aucs)) if aucs else None, "baselines": base_f1,
+            "best_base": best_base, "above": above, "level": level, "counts": counts, "base_counts": base_counts,
             "commit": (man.get("git") or {}).get("commit", "")[:7], "date": started, "build": _build(man),
+            "suite_sha256": ((man.get("suite") or {}).get("sha256") or "not recorded")[:12],
+            "model_sha256": (((man.get("lm") or {}).get("model_sha256")) or "not recorded")[:12],
             "differs": differs, "replaced": sorted(run.replace), "file": run.file, "kernel": run.kernel,
             "note": run.note, "baselines_from": base_commit if run.baselines else None}
 
@@ -238,7 +240,7 @@ def query_rows(path: Path = CURVES) -> list[dict]:
         k2 = grid.index(2)
         tgt = run["target"]
         two = next(r for r in tgt["rows"] if r["k"] == 2)
-        commit = ""
+        commit = "not recorded"
         for part in res.get("parts") or []:
             cmd = part.get("command", "")
             sources = re.search(r"--intent-sources (\S+)", cmd)
@@ -305,10 +307,10 @@ def table(rows: Sequence[Mapping], source: str) -> list[str]:
 
 def pooled(rows: Sequence[Mapping]) -> dict[str, float]:
     """F1 of gift-prob and of each baseline pooled over ``rows`` (every test object once)."""
-    out = {"gift-prob": _f1(*(sum(r["counts"][i] for r in rows) for i in range(3)))}
+    out = {"gift-prob": _add([r["counts"] for r in rows]).f1}
     for b in BASELINES:
         if rows and all(b in r["base_counts"] for r in rows):
-            out[b] = _f1(*(sum(r["base_counts"][b][i] for r in rows) for i in range(3)))
+            out[b] = _add([r["base_counts"][b] for r in rows]).f1
     return out
 
 
@@ -388,12 +390,16 @@ def render(rows: Sequence[Mapping], default: Mapping[str, str]) -> str:
         "",
         "Today's default `gift-prob`: " + ", ".join(f"`{k}={v}`" for k, v in default.items()) + ".",
         "",
-        "| suite | intents | file (`docs/results/data/`) | kernel | note |",
-        "|---|---|---|---|---|",
+        "Each file's suite is checked against the suite file here (its sha256 as the run recorded it; "
+        "`gift.study.sweeps.recorded_suite`), so a row never pairs a run with labels it was not scored on.",
+        "",
+        "| suite | intents | file (`docs/results/data/`) | kernel | suite sha256 | model sha256 | note |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         note = "–" if not r["note"] or r["note"] in r["differs"] else r["note"]
-        lines.append(f"| `{r['suite']}` | {r['source']} | `{r['file']}` | `{r['kernel']}` | {note} |")
+        lines.append(f"| `{r['suite']}` | {r['source']} | `{r['file']}` | `{r['kernel']}` | `{r['suite_sha256']}` | "
+                     f"`{r['model_sha256']}` | {note} |")
     return "\n".join(lines) + "\n"
 
 

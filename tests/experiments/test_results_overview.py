@@ -6,6 +6,11 @@ import json
 
 import pytest
 import script_module  # this directory: scripts/ files as modules
+import yaml
+
+from gift.core.errors import GiftError
+from gift.core.provenance import file_sha256
+from gift.testing import TINY_SUITE
 
 
 @pytest.fixture(scope="module")
@@ -30,37 +35,46 @@ def test_every_default_option_is_parsed_from_the_kernel_itself(mod):
         "a": "1", "b": "'x'"}
 
 
-def _result(suite: str, source: str, f1s: dict[str, dict[str, tuple[int, int, int]]], configuration=None) -> dict:
-    """A result file's shape as ``gift evaluate-alignment --out`` writes it; ``f1s``: kernel -> intent -> counts."""
+def _result(suite_path, source: str, f1s: dict[str, dict[str, tuple[int, int, int]]], configuration=None) -> dict:
+    """A result file's shape as ``gift evaluate-alignment --out`` writes it, scored on the suite file
+    ``suite_path`` (its hash as now); ``f1s``: kernel -> intent -> (tp, fp, fn)."""
     def rec(tp, fp, fn):
-        m = {"tp": tp, "fp": fp, "fn": fn, "f1": 2 * tp / (2 * tp + fp + fn), "auc": 0.9}
+        m = {"tp": tp, "fp": fp, "tn": 0, "fn": fn, "f1": 2 * tp / (2 * tp + fp + fn), "auc": 0.9}
         return {"metrics": {c: {"all": dict(m)} for c in ("train-calibrated", "oracle")}}
     kernels = {k: {"intents": {i: rec(*c) for i, c in v.items()}} for k, v in f1s.items()}
     if configuration:
         kernels["gift-prob"]["configuration"] = configuration
-    return {"suite": suite, "intent_source": source, "kernels": kernels,
-            "manifest": {"git": {"commit": "c" * 40}, "runs": [{"started": "2026-12-06T01:00:00"}],
-                         "lm": {"llama_cpp": "0.3.36; CPU : AVX512 = 1"}}}
+    suite = {"name": "tiny", "path": str(suite_path), "sha256": file_sha256(suite_path)}
+    return {"suite": "tiny", "suite_path": str(suite_path), "intent_source": source, "kernels": kernels,
+            "manifest": {"git": {"commit": "c" * 40}, "runs": [{"started": "2026-12-06T01:00:00"}], "suite": suite,
+                         "lm": {"llama_cpp": "0.3.36; CPU : AVX512 = 1", "model_sha256": "d" * 64}}}
 
 
 def test_a_row_pools_counts_replaces_a_rerun_intent_and_names_what_differs(mod, tmp_path, monkeypatch):
     monkeypatch.setattr(mod, "DATA", tmp_path)
-    main = _result("s", "inferred", {"gift-prob": {"a": (4, 0, 0), "b": (1, 3, 3)},
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(yaml.safe_dump(TINY_SUITE, sort_keys=False), encoding="utf-8")
+    main = _result(suite, "inferred", {"gift-prob": {"a": (4, 0, 0), "b": (1, 3, 3)},
                                      "language": {"a": (2, 2, 2), "b": (2, 2, 2)},
                                      "vision": {"a": (1, 3, 3), "b": (4, 0, 0)}},
                    configuration="GiftProbKernel(check='fit', ask_text='name', language_kernel=x)")
-    rerun = _result("s", "inferred", {"gift-prob": {"b": (4, 0, 0)}})
+    rerun = _result(suite, "inferred", {"gift-prob": {"b": (4, 0, 0)}})
     (tmp_path / "main.json").write_text(json.dumps(main))
     (tmp_path / "rerun.json").write_text(json.dumps(rerun))
     default = {"check": "'fit'", "ask_text": "'both'", "rungs": "'both'"}
-    r = mod.row(mod.Run("s", "inferred", "main.json", replace={"b": "rerun.json"}), default)
+    r = mod.row(mod.Run("tiny", "inferred", "main.json", replace={"b": "rerun.json"}), default)
     assert r["f1"] == pytest.approx(1.0)  # a and the rerun b: 8 tp, nothing wrong
     assert r["baselines"]["language"] == pytest.approx(0.5)  # 4 tp, 4 fp, 4 fn
     assert r["baselines"]["vision"] == pytest.approx(10 / 16)  # 5 tp, 3 fp, 3 fn
     assert (r["above"], r["level"]) == (1, 1)  # a: 1.0 against 0.5; b: 1.0 against vision's 1.0
     assert r["differs"] == "ask_text='name', no rungs yet"
-    assert r["build"] == "AVX-512" and r["commit"] == "ccccccc"
-    with pytest.raises(SystemExit, match="holds s / inferred, not s / ground-truth"):
-        mod.row(mod.Run("s", "ground-truth", "main.json"), default)
+    assert r["build"] == "AVX-512" and r["commit"] == "ccccccc" and r["model_sha256"] == "d" * 12
+    assert r["suite_sha256"] == file_sha256(suite)[:12]
+    with pytest.raises(SystemExit, match="holds tiny / inferred, not tiny / ground-truth"):
+        mod.row(mod.Run("tiny", "ground-truth", "main.json"), default)
     with pytest.raises(SystemExit, match="missing"):
-        mod.row(mod.Run("s", "inferred", "nowhere.json"), default)
+        mod.row(mod.Run("tiny", "inferred", "nowhere.json"), default)
+    # a suite edited after the run: its labels are no longer the ones the run was scored on
+    suite.write_text(suite.read_text(encoding="utf-8") + "\n# edited\n", encoding="utf-8")
+    with pytest.raises(GiftError, match="has changed since the run"):
+        mod.row(mod.Run("tiny", "inferred", "main.json"), default)
