@@ -1,7 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20`` and ``gift-dev21``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev20``, ``gift-dev21`` and ``gift-dev22``: new intents and objects, none borrowed from the suites they are
+checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -261,6 +262,19 @@ DEV_SUITES = {
                        r"|potter|\bkilns?\b|\bthrow(?:n|ing)? pots?\b|ceramicist"
                        r"|puzzl|jigsaw|tangram|\bsoma\b|hanoi|brain.?teas|\bmazes?\b"
                        r"|\bfluff|\blint\b|\bfuzz|\bbobbl|\bpill(?:s|ing|ed)?\b|gleener|\bde-?fuzz|\bde-?pill",
+    },
+    "gift-dev22": {
+        "siblings": [("dresses", "gilded_things"), ("salad_leaves", "velvet_things"),
+                     ("monopoly_kit", "bingo_kit"), ("essential_oils", "drain_clearers")],
+        "label_words": r"\bdress|\bgowns?\b|\bfrocks?\b|sundress|cheongsam|qipao|dirndl|gymslip|shirtwaister"
+                       r"|\bgild|\bgilt|gold.?leaf|ormolu|vermeil"
+                       r"|salad|lettuce|\bleaves\b|\bleafy|\bgreens\b|spinach|radicchio|fris[eé]e|endive|chicory"
+                       r"|\bm[aâ]che\b|little gems?|\bcos\b|romaine|iceberg|rocket|watercress"
+                       r"|velvet|velour|velveteen"
+                       r"|monopol|community chest|mayfair|free parking|title deed|hasbro"
+                       r"|bingo|housey|housie|tambola|tombola|\bdabb?ers?\b|\bdaubers?\b|\blotto\b"
+                       r"|essential|\boils?\b|aromatherap|neroli|ylang|patchouli"
+                       r"|\bdrains?\b|unblock|unclog|\bblocked\b|\bplung|caustic|drano|zip.?it\b|\bplumb",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
