@@ -59,6 +59,7 @@ ROLES: dict[str, str] = {
     "gift-dev18": "blind; reported only",
     "gift-dev19": "blind; the part rung not adopted",
     "gift-dev20": "blind; reported only",
+    "gift-dev21": "blind; reported only",
 }
 
 
@@ -129,6 +130,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev19", "ground-truth", F + "gift-dev19-ground-truth.json"),
     Run("gift-dev20", "inferred", F + "gift-dev20-inferred.json"),
     Run("gift-dev20", "ground-truth", F + "gift-dev20-ground-truth.json"),
+    Run("gift-dev21", "inferred", F + "gift-dev21-inferred.json"),
+    Run("gift-dev21", "ground-truth", F + "gift-dev21-ground-truth.json"),
 )
 
 
