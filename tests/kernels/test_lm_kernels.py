@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import gift
 from gift.core.data import DISTRACTOR, Completion, Intent, ObjectSpec
@@ -19,7 +21,7 @@ from gift.core.errors import GiftError, LMAnswerError, ValidationError
 from gift.core.interfaces import LMBackend, SimilarityKernel
 from gift.core.suite import load_suite
 from gift_kernels import prompts
-from gift_kernels.lm_kernels import (GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_category_answer,
+from gift_kernels.lm_kernels import (RUNGS, GiftProbKernel, MappingKernel, NoIntentMappingKernel, parse_category_answer,
                                      parse_mapping)
 
 SUITE = str(Path(__file__).parent / "data" / "lm_dev_suite.yaml")
@@ -998,3 +1000,59 @@ def test_gift_prob_answers_as_evidence_are_references_of_the_minilm_term_and_wei
     assert rs.details["weights"] == pytest.approx({t: sep[t] / sum(sep.values()) for t in sep})
     assert rs.details["evidence"] == {"yes": ["crayons"], "no": ["toothbrush"]}
     assert GiftProbKernel().rescore_with == "evidence"  # the default (docs/results/queries.md, gift-dev10)
+
+
+def test_shared_name_category_reads_the_word_every_demonstrated_name_has_and_no_other_has():
+    """The name rung (rungs="both+names") asks no LM: the word every handled name has and no left-alone name
+    has, in the singular; containers before "of", possessives and stopwords are not words of the kind."""
+    f = prompts.shared_name_category
+    assert f(["wicker shopping basket", "coiled seagrass storage baskets"], ["brass carriage clock"]) == "basket things"
+    assert f(["red plastic dustpan", "white plastic coat hanger"], ["box of cornflakes"]) == "plastic things"
+    assert f(["box of cornflakes", "box of muesli"]) is None  # the container is not the kind
+    assert f(["potter's wire cutter", "potter's rib"]) == "potter things"
+    assert f(["wire cutter", "wire brush"], ["wire coat hanger"]) is None  # a left-alone object has it too
+    assert f(["bundle of paper straws", "reusable glass straw"]) == "straw things"
+    assert f(["cut glasses", "glass jar"]) == "glass things"
+    assert f(["dried red roses", "dried red sunflower"]) == "red things"  # the last shared word of the first name
+    assert f(["fencing mask"]) is None and f([]) is None  # one name shares everything with itself: no rung
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.text(alphabet="abcdefghij 'sof-", max_size=30), min_size=0, max_size=4),
+       st.lists(st.text(alphabet="abcdefghij 'sof-", max_size=30), max_size=4))
+def test_shared_name_category_is_none_or_a_word_of_every_handled_name(handled, left_alone):
+    cat = prompts.shared_name_category(handled, left_alone)
+    if cat is not None:
+        word = cat.removesuffix(" things")
+        assert len(handled) >= 2 and " " not in word and len(word) >= 2
+        assert all(word in n.lower() for n in handled)
+
+
+def test_gift_prob_name_rung_joins_the_ladder_without_an_lm_call():
+    """rungs="both+names": the breadth and facet calls as with "both", and the demonstrated objects' shared name
+    word as one more rung, asked like the others; a training object left out falls back to the full rung."""
+    train = [ObjectSpec("felt pen", "a pen with a felt tip"), ObjectSpec("felt coaster", "a coaster of felt"),
+             ObjectSpec("banana", "a yellow fruit"), ObjectSpec("coffee mug", "a ceramic mug")]
+    test = [ObjectSpec("felt hat", "a hat of felt"), ObjectSpec("apple", "a red fruit")]
+
+    def answer(messages, seed):
+        if messages[0].content == prompts.LADDER_SYSTEM:
+            return json.dumps({"narrow": "pens", "middle": "stationery", "broad": "office things"})
+        if messages[0].content == prompts.FACET_SYSTEM:
+            return json.dumps({"kind": "none", "material": "none", "property": "none"})
+        return category_json("stationery")
+
+    def run(rungs):
+        lm = ScriptedLM(answer=answer, probs=lambda text: {"yes": 0.6, "no": 0.4})
+        rs = GiftProbKernel(lm=lm, combine="none", rungs=rungs).score(test, train, PICKED_BANANA,
+                                                                       ("felt pen", "felt coaster"))
+        ladder_calls = sum(c[0][0].content in (prompts.LADDER_SYSTEM, prompts.FACET_SYSTEM) for c in lm.calls)
+        asked = {c[0][1].content for c in lm.calls if c[0][0].content == prompts.RELEVANCE_SYSTEM}
+        return rs, ladder_calls, asked
+
+    rs, calls, asked = run("both+names")
+    base, base_calls, base_asked = run("both")
+    assert rs.details["ladder"]["categories"] == [*base.details["ladder"]["categories"], "felt things"]
+    assert calls == base_calls > 0  # the name rung costs no ladder call
+    assert any(q.startswith("Is a felt hat (a hat of felt) one of the felt things?") for q in asked - base_asked)
+    assert "both+names" in RUNGS

@@ -243,7 +243,7 @@ CATEGORY_FROM = ("goal+objects", "goal")
 CANDIDATES = ("text", "all")
 SELECT = ("first", "margin")
 LADDER = ("never", "inferred", "always")
-RUNGS = ("breadth", "facets", "both", "all")
+RUNGS = ("breadth", "facets", "both", "all", "both+names")
 CHECK = ("none", "fit", "weight", "margin", "fit-best")
 #: How :meth:`GiftProbKernel.score_with_answers` uses the human's answers: ``"ladder"`` names the category ladder
 #: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
@@ -405,6 +405,8 @@ class GiftProbKernel(RelevanceKernel):
         #: (mean inferred train-calibrated F1 0.808 -> 0.813, no suite loses; facets alone lose 0.029 on
         #: gift-dev2); docs/results/front_half.md, section 11. ``"all"``: those and, from a third call, a part
         #: or feature the objects have ("things with a chain"; :func:`gift_kernels.prompts.part_messages`).
+        #: ``"both+names"``: ``"both"`` and, with no LM call, the word every demonstrated object's name has and no
+        #: other training object's ("basket things"; :func:`gift_kernels.prompts.shared_name_category`).
         self.rungs = rungs
         if check not in CHECK:
             raise GiftError(f"gift-prob: check must be one of {CHECK}, got {check!r}")
@@ -578,12 +580,16 @@ class GiftProbKernel(RelevanceKernel):
 
     def _ladder_kinds(self) -> tuple[str, ...]:
         return {"breadth": ("breadth",), "facets": ("facets",), "both": ("breadth", "facets"),
-                "all": ("breadth", "facets", "parts")}[self.rungs]
+                "all": ("breadth", "facets", "parts"), "both+names": ("breadth", "facets", "names")}[self.rungs]
 
     def _ask_ladder(self, kind: str, handled: Sequence[str], left_alone: Sequence[str],
                     descriptions: Mapping[str, str] | None = None) -> dict[str, str]:
         """One ladder call (``kind``: ``"breadth"``, ``"facets"`` or ``"parts"``), memoized: its named levels. The
-        objects are shown with ``descriptions`` when ``ladder_text="name+description"``."""
+        objects are shown with ``descriptions`` when ``ladder_text="name+description"``. ``"names"`` asks no LM: the
+        word the handled names share (:func:`gift_kernels.prompts.shared_name_category`), if any."""
+        if kind == "names":
+            cat = prompts.shared_name_category(handled, left_alone)
+            return {prompts.NAME_LEVELS[0]: cat} if cat else {}
         descriptions = None if self.ladder_text == "name" else {n: (descriptions or {}).get(n, "")
                                                                  for n in (*handled, *left_alone)}
         key = (kind, tuple(handled), tuple(left_alone), descriptions and tuple(descriptions.values()))

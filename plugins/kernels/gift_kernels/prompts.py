@@ -393,6 +393,46 @@ def part_messages(handled: Sequence[str], left_alone: Sequence[str],
                                   descriptions)
 
 
+NAME_LEVELS: tuple[str, ...] = ("shared word",)
+
+#: Words that never name what objects share on their own (articles, prepositions, conjunctions).
+_NAME_STOPWORDS = frozenset({"a", "an", "the", "and", "or", "with", "without", "in", "on", "for", "to", "of", "from",
+                             "by", "at", "into"})
+
+
+def _name_words(name: str) -> list[tuple[str, str]]:
+    """(key, word) per content word of an object's name, in order: lower case, a possessive ``'s`` dropped, the
+    word before an "of" dropped as a container or quantity ("box of cornflakes", "pair of gloves"), stopwords and
+    words under three letters dropped; the key is the word's singular ("baskets" and "basket" match)."""
+    words = re.findall(r"[a-z]+", re.sub(r"'s\b", "", name.lower()))
+    out = []
+    for i, w in enumerate(words):
+        if w in _NAME_STOPWORDS or len(w) < 3 or (i + 1 < len(words) and words[i + 1] == "of"):
+            continue
+        out.append((_singular(w), w))
+    return out
+
+
+def _singular(word: str) -> str:
+    """A crude singular: "boxes" -> "box", "glasses" -> "glass", "baskets" -> "basket", "glass" stays."""
+    if word.endswith(("sses", "shes", "ches", "xes", "zes")):
+        return word[:-2]
+    return word[:-1] if word.endswith("s") and not word.endswith(("ss", "us", "is")) else word
+
+
+def shared_name_category(handled: Sequence[str], left_alone: Sequence[str] = ()) -> str | None:
+    """A category read off the names alone, no LM: ``"<word> things"`` for a word every one of the (at least two)
+    ``handled`` names has and no ``left_alone`` name has ("wicker shopping basket", "coiled seagrass storage
+    basket" -> "basket things"; the word in the singular); the last such word of the first name where several are
+    shared; ``None`` where none is (or fewer than two names are handled)."""
+    if len(handled) < 2:
+        return None
+    keys = [{k for k, _ in _name_words(n)} for n in handled]
+    others = {k for n in left_alone for k, _ in _name_words(n)}
+    shared = [(k, w) for k, w in _name_words(handled[0]) if all(k in ks for ks in keys[1:]) and k not in others]
+    return f"{shared[-1][0]} things" if shared else None
+
+
 _NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
 
 
