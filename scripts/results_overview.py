@@ -119,6 +119,7 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev13", "inferred", F + "gift-dev13-inferred.json"),
     Run("gift-dev13", "ground-truth", F + "gift-dev13-ground-truth.json"),
     Run("gift-dev14", "inferred", F + "gift-dev14-inferred.json"),
+    Run("gift-dev14", "ground-truth", F + "gift-dev14-ground-truth.json"),
     Run("gift-dev15", "inferred", F + "gift-dev15-inferred.json",
         replace={"belled_things": F + "avoided-gift-dev15-belled_things-inferred.json"}),
     Run("gift-dev15", "ground-truth", F + "gift-dev15-ground-truth.json"),
