@@ -1055,4 +1055,6 @@ def test_gift_prob_name_rung_joins_the_ladder_without_an_lm_call():
     assert rs.details["ladder"]["categories"] == [*base.details["ladder"]["categories"], "felt things"]
     assert calls == base_calls > 0  # the name rung costs no ladder call
     assert any(q.startswith("Is a felt hat (a hat of felt) one of the felt things?") for q in asked - base_asked)
+    # the felt pen's own ladder (named without it) has no shared word: the full rung stands in
+    assert any(q.startswith("Is a felt pen (a pen with a felt tip) one of the felt things?") for q in asked)
     assert "both+names" in RUNGS

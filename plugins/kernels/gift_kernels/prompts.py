@@ -400,17 +400,13 @@ _NAME_STOPWORDS = frozenset({"a", "an", "the", "and", "or", "with", "without", "
                              "by", "at", "into"})
 
 
-def _name_words(name: str) -> list[tuple[str, str]]:
-    """(key, word) per content word of an object's name, in order: lower case, a possessive ``'s`` dropped, the
-    word before an "of" dropped as a container or quantity ("box of cornflakes", "pair of gloves"), stopwords and
-    words under three letters dropped; the key is the word's singular ("baskets" and "basket" match)."""
+def _name_words(name: str) -> list[str]:
+    """The content words of an object's name, in order and in the singular ("baskets" and "basket" match): lower
+    case, a possessive ``'s`` dropped, the word before an "of" dropped as a container or quantity ("box of
+    cornflakes", "pair of gloves"), stopwords and words under three letters dropped."""
     words = re.findall(r"[a-z]+", re.sub(r"'s\b", "", name.lower()))
-    out = []
-    for i, w in enumerate(words):
-        if w in _NAME_STOPWORDS or len(w) < 3 or (i + 1 < len(words) and words[i + 1] == "of"):
-            continue
-        out.append((_singular(w), w))
-    return out
+    return [_singular(w) for i, w in enumerate(words)
+            if w not in _NAME_STOPWORDS and len(w) >= 3 and not (i + 1 < len(words) and words[i + 1] == "of")]
 
 
 def _singular(word: str) -> str:
@@ -427,10 +423,10 @@ def shared_name_category(handled: Sequence[str], left_alone: Sequence[str] = ())
     shared; ``None`` where none is (or fewer than two names are handled)."""
     if len(handled) < 2:
         return None
-    keys = [{k for k, _ in _name_words(n)} for n in handled]
-    others = {k for n in left_alone for k, _ in _name_words(n)}
-    shared = [(k, w) for k, w in _name_words(handled[0]) if all(k in ks for ks in keys[1:]) and k not in others]
-    return f"{shared[-1][0]} things" if shared else None
+    rest = [set(_name_words(n)) for n in handled[1:]]
+    others = {w for n in left_alone for w in _name_words(n)}
+    shared = [w for w in _name_words(handled[0]) if all(w in ws for ws in rest) and w not in others]
+    return f"{shared[-1]} things" if shared else None
 
 
 _NO_NAME = re.compile(r"^(none|nothing|n/?a|no \w+|not applicable|unknown)$", re.IGNORECASE)
