@@ -57,6 +57,8 @@ DEV21_LABEL = {"baskets": "x1a", "pleated_things": "x1b", "breakfast_cereals": "
                "fencing_kit": "x3a", "pottery_kit": "x3b", "puzzles": "x4a", "fluff_removers": "x4b"}
 DEV22_LABEL = {"dresses": "y1a", "gilded_things": "y1b", "salad_leaves": "y2a", "velvet_things": "y2b",
                "monopoly_kit": "y3a", "bingo_kit": "y3b", "essential_oils": "y4a", "drain_clearers": "y4b"}
+DEV23_LABEL = {"mangoes": "z1a", "lacquered_things": "z1b", "lunchboxes": "z2a", "copper_things": "z2b",
+               "dnd_kit": "z3a", "cluedo_kit": "z3b", "fossils": "z4a", "drilling_things": "z4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -110,7 +112,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev12": DEV12_LABEL, "gift-dev13": DEV13_LABEL, "gift-dev14": DEV14_LABEL,
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
-                    "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL}
+                    "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
+                    "gift-dev23": DEV23_LABEL}
 
 
 def main() -> None:
