@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21`` and ``gift-dev22``: new intents and objects, none borrowed from the suites they are
-checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22`` and ``gift-dev23``: new intents and objects, none borrowed from the
+suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -275,6 +275,21 @@ DEV_SUITES = {
                        r"|bingo|housey|housie|tambola|tombola|\bdabb?ers?\b|\bdaubers?\b|\blotto\b"
                        r"|essential|\boils?\b|aromatherap|neroli|ylang|patchouli"
                        r"|\bdrains?\b|unblock|unclog|\bblocked\b|\bplung|caustic|drano|zip.?it\b|\bplumb",
+    },
+    "gift-dev23": {
+        "siblings": [("mangoes", "lacquered_things"), ("lunchboxes", "copper_things"),
+                     ("dnd_kit", "cluedo_kit"), ("fossils", "drilling_things")],
+        "label_words": r"mango|alphonso|ataulfo|kesar|chaunsa|carabao|tommy atkins|\bkent\b|keitt|haden"
+                       r"|lacquer|japann|urushi|cinnabar|shellac|maki-?e\b|\binros?\b|\blac\b"
+                       r"|lunch|bento|tiffin|\bdabbas?\b|snap tins?|crib tins?"
+                       r"|copper|\bcupr|cezve|ibrik|cataplana|moscow mule|verdigris"
+                       r"|dungeon|dragon|\bd ?& ?d\b|\bdnd\b|role.?play|\brpgs?\b|beholder|xanathar|monster manual"
+                       r"|player'?s handbook|wizards of the coast"
+                       r"|cluedo|\bclue\b|whodunn?it|colonel mustard|professor plum|reverend green|miss scarlett?"
+                       r"|mrs\.? peacock|mrs\.? white|dr\.? black|lead pip"
+                       r"|fossil|ammonite|trilobite|belemnite|petrif|pal(?:a|ae|e)ontolog|crinoid"
+                       r"|\bdrill|\bbor(?:e|es|ed|ing)\b|\bbits?\b|gimlet|\bbrace\b|auger|forstner|countersink"
+                       r"|pin vi[cs]e|archimedes",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
