@@ -406,7 +406,8 @@ class GiftProbKernel(RelevanceKernel):
         #: gift-dev2); docs/results/front_half.md, section 11. ``"all"``: those and, from a third call, a part
         #: or feature the objects have ("things with a chain"; :func:`gift_kernels.prompts.part_messages`).
         #: ``"both+names"``: ``"both"`` and, with no LM call, the word every demonstrated object's name has and no
-        #: other training object's ("basket things"; :func:`gift_kernels.prompts.shared_name_category`).
+        #: other training object's ("basket things"; :func:`gift_kernels.prompts.shared_name_category`); not
+        #: adopted: +0.008 inferred F1 on the blind gift-dev22 where its rule asked for +0.010 (front_half.md, 40).
         self.rungs = rungs
         if check not in CHECK:
             raise GiftError(f"gift-prob: check must be one of {CHECK}, got {check!r}")
