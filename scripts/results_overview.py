@@ -61,6 +61,7 @@ ROLES: dict[str, str] = {
     "gift-dev19": "blind; the part rung not adopted",
     "gift-dev20": "blind; reported only",
     "gift-dev21": "blind; reported only",
+    "gift-dev22": "blind; the name rung not adopted",
 }
 
 
@@ -135,6 +136,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev20", "ground-truth", F + "gift-dev20-ground-truth.json"),
     Run("gift-dev21", "inferred", F + "gift-dev21-inferred.json"),
     Run("gift-dev21", "ground-truth", F + "gift-dev21-ground-truth.json"),
+    Run("gift-dev22", "inferred", F + "gift-dev22-inferred.json"),
+    Run("gift-dev22", "ground-truth", F + "gift-dev22-ground-truth.json"),
 )
 
 
