@@ -59,6 +59,8 @@ DEV22_LABEL = {"dresses": "y1a", "gilded_things": "y1b", "salad_leaves": "y2a", 
                "monopoly_kit": "y3a", "bingo_kit": "y3b", "essential_oils": "y4a", "drain_clearers": "y4b"}
 DEV23_LABEL = {"mangoes": "z1a", "lacquered_things": "z1b", "lunchboxes": "z2a", "copper_things": "z2b",
                "dnd_kit": "z3a", "cluedo_kit": "z3b", "fossils": "z4a", "drilling_things": "z4b"}
+DEV24_LABEL = {"cherries": "a1a", "frog_shaped_things": "a1b", "pizzas": "a2a", "corduroy_things": "a2b",
+               "netball_kit": "a3a", "trivial_pursuit_kit": "a3b", "meteorites": "a4a", "mexican_things": "a4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -113,7 +115,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
-                    "gift-dev23": DEV23_LABEL}
+                    "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL}
 
 
 def main() -> None:
