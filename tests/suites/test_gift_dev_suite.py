@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21``, ``gift-dev22`` and ``gift-dev23``: new intents and objects, none borrowed from the
-suites they are checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23`` and ``gift-dev24``: new intents and objects, none
+borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -290,6 +290,20 @@ DEV_SUITES = {
                        r"|fossil|ammonite|trilobite|belemnite|petrif|pal(?:a|ae|e)ontolog|crinoid"
                        r"|\bdrill|\bbor(?:e|es|ed|ing)\b|\bbits?\b|gimlet|\bbrace\b|auger|forstner|countersink"
                        r"|pin vi[cs]e|archimedes",
+    },
+    "gift-dev24": {
+        "siblings": [("cherries", "frog_shaped_things"), ("pizzas", "corduroy_things"),
+                     ("netball_kit", "trivial_pursuit_kit"), ("meteorites", "mexican_things")],
+        "label_words": r"cherr|morello|rainier|\bbings?\b|montmorency|amarena|griott|maraschino|kirsch|\blapins\b"
+                       r"|\bfrog|\btoads?\b|amphibi|tadpole|croak|ribbit|kermit|keroppi|greninja|jeremy fisher"
+                       r"|pizz|margherita|quattro stagioni|calzone"
+                       r"|corduroy|needlecord|jumbo.?cord|elephant.?cord|\bcords\b|\bwales?\b|\bwaled\b|pinwale"
+                       r"|netball|netburner|goal shooter|goal attack|goal defen[cs]e|goal keeper|wing attack"
+                       r"|wing defen[cs]e"
+                       r"|trivial|pursuit|\bgenus\b|baby boomer"
+                       r"|meteor|campo del cielo|gibeon|sikhote|chondrit|pallasit|widmanst|shooting stars?"
+                       r"|space rocks?|asteroid|\bbolides?\b"
+                       r"|mexic|m[eé]xico",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
