@@ -61,6 +61,8 @@ DEV23_LABEL = {"mangoes": "z1a", "lacquered_things": "z1b", "lunchboxes": "z2a",
                "dnd_kit": "z3a", "cluedo_kit": "z3b", "fossils": "z4a", "drilling_things": "z4b"}
 DEV24_LABEL = {"cherries": "a1a", "frog_shaped_things": "a1b", "pizzas": "a2a", "corduroy_things": "a2b",
                "netball_kit": "a3a", "trivial_pursuit_kit": "a3b", "meteorites": "a4a", "mexican_things": "a4b"}
+DEV25_LABEL = {"figs": "b1a", "house_shaped_things": "b1b", "burgers": "b2a", "crocheted_things": "b2b",
+               "pickleball_kit": "b3a", "catan_kit": "b3b", "butterflies": "b4a", "signalling_things": "b4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -115,7 +117,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
-                    "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL}
+                    "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL}
 
 
 def main() -> None:
