@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23`` and ``gift-dev24``: new intents and objects, none
-borrowed from the suites they are checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24`` and ``gift-dev25``: new intents and
+objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -304,6 +304,21 @@ DEV_SUITES = {
                        r"|meteor|campo del cielo|gibeon|sikhote|chondrit|pallasit|widmanst|shooting stars?"
                        r"|space rocks?|asteroid|\bbolides?\b"
                        r"|mexic|m[eé]xico",
+    },
+    "gift-dev25": {
+        "siblings": [("figs", "house_shaped_things"), ("burgers", "crocheted_things"),
+                     ("pickleball_kit", "catan_kit"), ("butterflies", "signalling_things")],
+        "label_words": r"\bfigs?\b|ficus|brown turkeys?|black missions?|kadota|panach[eé]e|calimyrna|smyrna|\bbursa\b"
+                       r"|\bhous(?:e|es|ing)\b|\bcottages?\b|\bchalets?\b|\bhomes?\b|bungalow|\bcabins?\b|\bhuts?\b"
+                       r"|lilliput lane|cuckoo|nest.?box"
+                       r"|burger|\bpatt(?:y|ies)\b|big mac|whopper|quarter.?pounder|\bsliders?\b|hamburg"
+                       r"|crochet|amigurumi|granny.?squares?|\bafghans?\b|tunisian|\bfilet\b|tawashi"
+                       r"|pickle|\bdinks?\b|selkirk|franklin x-?40|dura fast|\bonix\b|joola"
+                       r"|catan|settlers?\b|seafarers|longest road|largest army|teuber"
+                       r"|butterfl|lepidopter|morpho|red admirals?|\bpeacocks?\b|painted lad(?:y|ies)|swallowtail"
+                       r"|birdwing|monarch|brimstone|tortoiseshell|fritillar|papilio"
+                       r"|signal|\bsos\b|mayday|distress|semaphore|\bmorse\b|heliograph|aldis|thunderer|\bbeacons?\b"
+                       r"|\bflares?\b|\bwhistl",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
