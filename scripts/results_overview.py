@@ -62,6 +62,7 @@ ROLES: dict[str, str] = {
     "gift-dev20": "blind; reported only",
     "gift-dev21": "blind; reported only",
     "gift-dev22": "blind; the name rung not adopted",
+    "gift-dev23": "blind; reported only",
 }
 
 
@@ -138,6 +139,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev21", "ground-truth", F + "gift-dev21-ground-truth.json"),
     Run("gift-dev22", "inferred", F + "gift-dev22-inferred.json"),
     Run("gift-dev22", "ground-truth", F + "gift-dev22-ground-truth.json"),
+    Run("gift-dev23", "inferred", F + "gift-dev23-inferred.json"),
+    Run("gift-dev23", "ground-truth", F + "gift-dev23-ground-truth.json"),
 )
 
 
