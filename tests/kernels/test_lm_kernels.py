@@ -221,6 +221,37 @@ def test_gift_prob_matrix_rule_log_odds_and_leave_one_out_scores():
     assert questions[1][0][1].content.startswith('Is a thing described as "sticks of colored wax" one of the Art')
 
 
+def test_gift_prob_ask_text_combines_the_name_only_question_with_the_other_forms():
+    """ask_text="name": the name alone; "all": the three forms averaged; "both&name": the smaller of the default's
+    mean and the name-only log-odds, so a look-alike (a toothbrush described like crayons) must pass its name."""
+    p = {"name+description": {"toothbrush": 0.8}, "description": {"toothbrush": 0.9}, "name": {"toothbrush": 0.1}}
+
+    def probs(text):
+        m = re.search(r'Is a thing described as "(.+?)" one of', text)
+        if m:
+            name, form = NAME_OF[m.group(1)], "description"
+        else:
+            m = re.search(r"Is a (.+?)( \(.*\))? one of the", text)
+            name, form = m.group(1), "name+description" if m.group(2) else "name"
+        q = p[form].get(name, 0.7 if name == "crayons" else 0.2)
+        return {"yes": q, "no": 1.0 - q}
+
+    def lo(q):
+        return np.log(q / (1 - q))
+
+    asked = {}
+    for ask_text in ("name", "both", "all", "both&name"):
+        lm = ScriptedLM(answer=lambda m, s: category_json("Art supplies."), probs=probs)
+        k = GiftProbKernel(lm=lm, combine="none", category_from="goal", ask_text=ask_text)
+        asked[ask_text] = (k.log_odds(TEST[:2], ART), k.calls)
+    assert np.allclose(asked["name"][0], [lo(0.7), lo(0.1)]) and asked["name"][1] == 1 + 2  # the category, then a question per object
+    assert np.allclose(asked["both"][0], [lo(0.7), (lo(0.8) + lo(0.9)) / 2]) and asked["both"][1] == 1 + 4
+    assert np.allclose(asked["all"][0], [lo(0.7), (lo(0.8) + lo(0.9) + lo(0.1)) / 3]) and asked["all"][1] == 1 + 6
+    assert np.allclose(asked["both&name"][0], [lo(0.7), lo(0.1)]) and asked["both&name"][1] == 1 + 6
+    assert "Is a crayons one of the Art supplies?" in prompts.relevance_messages(
+        TEST[0], ART.text, category="Art supplies", object_text="name")[1].content
+
+
 def test_gift_prob_names_the_category_from_the_goal_and_the_demonstrated_objects_leaving_each_one_out():
     def answer(messages, seed):  # the category the scripted LM names: from the last question's handled objects
         m = re.search(r"kept clear of them\): (.*)\.\n", messages[-1].content)
@@ -292,7 +323,7 @@ def test_gift_prob_fails_clearly_without_log_probabilities_or_intent_and_on_bad_
     with pytest.raises(GiftError, match="conditions on an intent"):
         GiftProbKernel(lm=ScriptedLM(probs=lambda t: {"yes": .5, "no": .5})).score(TEST, TRAIN, None)
     for bad in ({"template": "nope"}, {"combine": "mean"}, {"weight": 2.0}, {"embed_reference": "x"},
-                {"standardize": "y"}, {"embed_text": "name"}, {"ask_text": "name"}):
+                {"standardize": "y"}, {"embed_text": "name"}, {"ask_text": "names"}):
         with pytest.raises(GiftError, match="gift-prob"):
             GiftProbKernel(**bad)
     with pytest.raises(GiftError, match="not training objects"):
@@ -322,7 +353,7 @@ def test_a_question_on_the_description_alone_never_shows_the_name():
     assert "a cheese grater one of the cheeses" in prompts.relevance_messages(
         bare, "g", category="cheeses", object_text="description")[1].content
     with pytest.raises(GiftError, match="object_text must be one of"):
-        prompts.relevance_messages(obj, "g", object_text="name")
+        prompts.relevance_messages(obj, "g", object_text="name only")
 
 
 def test_ask_text_both_averages_the_log_odds_of_the_named_and_the_described_question():

@@ -456,8 +456,10 @@ def fallback_category(goal: str) -> str:
 
 #: How the object is shown in a yes/no question: ``"name+description"`` ("a cheese grater (A four-sided steel box
 #: ...)") or ``"description"`` ("a thing described as "A four-sided steel box ..."": no name, so that a word the
-#: name shares with the category cannot carry the answer; the name when the object has no description).
-OBJECT_TEXT = ("name+description", "description")
+#: name shares with the category cannot carry the answer; the name when the object has no description) or
+#: ``"name"`` ("a cheese grater": the name alone, so that a description that reads like a member's cannot carry
+#: the answer either).
+OBJECT_TEXT = ("name+description", "description", "name")
 
 
 def relevance_messages(obj: ObjectSpec, goal: str, template: str = "category",
@@ -470,6 +472,8 @@ def relevance_messages(obj: ObjectSpec, goal: str, template: str = "category",
     described = obj.description.strip()
     if object_text == "description" and described:
         name, desc = f'thing described as "{described.rstrip(".")}"', ""
+    elif object_text == "name":
+        name, desc = obj.name, ""
     else:
         name = obj.name
         desc = f" ({described})" if use_description and described else ""
