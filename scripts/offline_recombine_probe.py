@@ -10,11 +10,17 @@ recomputation is then not the kernel's) and then scores, with the train-calibrat
   ``size ** -n`` (``n``: the demonstrated objects; ``size``: the category's share of the scene's test objects the
   LM says yes to, hard ``P(yes) > 1/2`` or soft mean ``P(yes)``; at least ``1 / n_test``), or the smallest alone;
 - ``offset``: the cut moved by a fixed amount on the combined z-scale (one number for every intent);
-- ``combine``: the LM and MiniLM terms combined otherwise than by the reliability-weighted mean.
+- ``combine``: the LM and MiniLM terms combined otherwise than by the reliability-weighted mean;
+- ``lm veto``: the default combination, but an object whose z-scored LM term is below a level is left out whatever
+  the MiniLM term says (front_half.md, section 42: the look-alike distractors get in on the MiniLM term).
 
-Prints pooled train-calibrated F1 per suite for every variant, the mean, and wins / losses against the saved runs.
+Prints pooled train-calibrated F1 per suite for every variant, the mean, and wins / losses against the saved runs;
+``--kinds`` prints instead, per run, how many test objects of each kind (members, distractors named like members,
+ones that look like members, the others) the saved decisions let in and how many each term alone puts above its
+scene's mean.
 
     python scripts/offline_recombine_probe.py [RUN.json:KERNEL ...]   # default: the used suites' latest runs
+    python scripts/offline_recombine_probe.py --kinds gift-dev23-inferred.json:gift-prob
 """
 
 from __future__ import annotations
@@ -132,6 +138,40 @@ def scored(run: dict, suite, kernel: str, weigh=None, combine=combine_mean,
     return tp, fp, fn
 
 
+KINDS = ("member", "named-alike", "look-alike", "other")
+
+
+def kinds(run: dict, suite, kernel: str) -> dict[str, dict[str, int]]:
+    """Per kind of test object (:data:`KINDS`; the suite's ``confounds``: ``lang`` named like a member, ``vis``
+    looks like one): ``n``, ``in`` (the saved train-calibrated decision lets it in), ``lm`` and ``minilm`` (that
+    term, z-scored over the intent's test and training objects, is above 0)."""
+    out = {k: {"n": 0, "in": 0, "lm": 0, "minilm": 0} for k in KINDS}
+    for intent_id, rec in run["kernels"][kernel]["intents"].items():
+        test = rec["scores"]["test"]
+        terms = rec["details"]["terms"]
+        z = {t: zscore(np.array(terms[t]["test"] + terms[t]["train"], dtype=float))[: len(test)]
+             for t in ("lm", "language")}
+        cut = rec["thresholds"]["train-calibrated"]["cut"]
+        for t in suite.intent(intent_id).test:
+            kind = "member" if t.relevant else ("named-alike" if "lang" in t.confounds else
+                                                "look-alike" if "vis" in t.confounds else "other")
+            i = test.index(t.object)
+            row = out[kind]
+            row["n"] += 1
+            row["in"] += int(rec["objects"][t.object]["decision"] > cut)
+            row["lm"] += int(z["lm"][i] > 0)
+            row["minilm"] += int(z["language"][i] > 0)
+    return out
+
+
+def lm_veto(level: float) -> Callable[[np.ndarray, np.ndarray, np.ndarray, int], np.ndarray]:
+    """The default combination, with every object whose z-scored LM term is below ``level`` put below the cut."""
+    def combine(lm: np.ndarray, emb: np.ndarray, rel: np.ndarray, n: int) -> np.ndarray:
+        z = combine_mean(lm, emb, rel, n)
+        return np.where(zscore(lm) < level, -np.inf, z)
+    return combine
+
+
 def f1(c: tuple[int, int, int]) -> float:
     tp, fp, fn = c
     return 2 * tp / (2 * tp + fp + fn) if tp else 0.0
@@ -147,28 +187,45 @@ def variants() -> dict[str, dict]:
     out["min of terms"] = {"combine": lambda lm, emb, rel, n: np.minimum(zscore(lm), zscore(emb))}
     out["mean - |diff|/4"] = {"combine": lambda lm, emb, rel, n: combine_mean(lm, emb, rel, n)
                               - 0.25 * np.abs(zscore(lm) - zscore(emb))}
+    for level in (-1.0, -0.5, 0.0):
+        out[f"lm veto {level:+.1f}"] = {"combine": lm_veto(level)}
     return out
 
 
 def main(argv: list[str] | None = None) -> dict:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("runs", nargs="*", default=list(DEFAULT_RUNS), help="RUN.json:KERNEL (relative to the data dir)")
+    p.add_argument("--kinds", action="store_true", help="count the kinds of test object each run lets in")
     args = p.parse_args(argv)
+    if args.kinds:
+        counts = {}
+        print("| run | " + " | ".join(f"{k}: in / LM / MiniLM above the mean" for k in KINDS) + " |")
+        print("|---|" + "---|" * len(KINDS))
+        for spec in args.runs:
+            path, kernel = spec.split(":", 1)
+            run = json.loads((DATA / path if not Path(path).is_absolute() else Path(path)).read_text(encoding="utf-8"))
+            counts[path] = c = kinds(run, recorded_suite(run, path), kernel)
+            print(f"| {Path(path).name} | " + " | ".join(f"{c[k]['in']} / {c[k]['lm']} / {c[k]['minilm']} of "
+                                                          f"{c[k]['n']}" for k in KINDS) + " |")
+        return counts
     table: dict[str, dict[str, float]] = {}
     for spec in args.runs:
         path, kernel = spec.split(":", 1)
         run = json.loads((DATA / path if not Path(path).is_absolute() else Path(path)).read_text(encoding="utf-8"))
         suite = recorded_suite(run, path)
-        table[run["suite"]] = {name: f1(scored(run, suite, kernel, **opts)) for name, opts in variants().items()}
+        # one row per run (a suite's inferred and true-intent runs are two rows)
+        row = f"{run['suite']} {run.get('intent_source', '')}".strip()
+        table[row] = {name: f1(scored(run, suite, kernel, **opts)) for name, opts in variants().items()}
     names = list(variants())
-    print("suite".ljust(12) + "".join(n.rjust(17) for n in names))
+    width = max(12, *(len(k) + 1 for k in table))
+    print("run".ljust(width) + "".join(n.rjust(17) for n in names))
     for suite, row in table.items():
-        print(suite.ljust(12) + "".join(f"{row[n]:17.3f}" for n in names))
+        print(suite.ljust(width) + "".join(f"{row[n]:17.3f}" for n in names))
     base = np.array([row["saved"] for row in table.values()])
-    print("mean".ljust(12) + "".join(f"{np.mean([row[n] for row in table.values()]):17.3f}" for n in names))
+    print("mean".ljust(width) + "".join(f"{np.mean([row[n] for row in table.values()]):17.3f}" for n in names))
     for n in names[1:]:
         v = np.array([row[n] for row in table.values()])
-        print(f"{n}: better on {(v > base + 1e-9).sum()}, worse on {(v < base - 1e-9).sum()} of {len(v)} suites")
+        print(f"{n}: better on {(v > base + 1e-9).sum()}, worse on {(v < base - 1e-9).sum()} of {len(v)} runs")
     return table
 
 

@@ -244,7 +244,8 @@ def test_gift_prob_ask_text_combines_the_name_only_question_with_the_other_forms
         lm = ScriptedLM(answer=lambda m, s: category_json("Art supplies."), probs=probs)
         k = GiftProbKernel(lm=lm, combine="none", category_from="goal", ask_text=ask_text)
         asked[ask_text] = (k.log_odds(TEST[:2], ART), k.calls)
-    assert np.allclose(asked["name"][0], [lo(0.7), lo(0.1)]) and asked["name"][1] == 1 + 2  # the category, then a question per object
+    # calls: the category, then a question per object and form
+    assert np.allclose(asked["name"][0], [lo(0.7), lo(0.1)]) and asked["name"][1] == 1 + 2
     assert np.allclose(asked["both"][0], [lo(0.7), (lo(0.8) + lo(0.9)) / 2]) and asked["both"][1] == 1 + 4
     assert np.allclose(asked["all"][0], [lo(0.7), (lo(0.8) + lo(0.9) + lo(0.1)) / 3]) and asked["all"][1] == 1 + 6
     assert np.allclose(asked["both&name"][0], [lo(0.7), lo(0.1)]) and asked["both&name"][1] == 1 + 6

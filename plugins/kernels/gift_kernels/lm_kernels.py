@@ -302,7 +302,8 @@ class GiftProbKernel(RelevanceKernel):
     ``ask_text`` (how the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds
     of the question with the name and the one with the description alone; ``"name+description"``;
     ``"description"``; ``"name"``; ``"all"``, the mean of those three; ``"both&name"``, the smaller of "both"'s
-    log-odds and the name-only question's, so that a look-alike must pass its name too), ``weight`` of the language term in the average, ``weighting`` (``"reliability"``: scale each
+    log-odds and the name-only question's, so that a look-alike must pass its name too), ``weight`` of the
+    language term in the average, ``weighting`` (``"reliability"``: scale each
     term's weight by ``max(AUC - 1/2, 0)`` of its leave-one-out scores on the training objects, so a term
     that inverts the demonstrated labels for this intent is dropped; all zero falls back to the plain
     weights; ``"equal"``: the plain weights), ``category_from`` (``"goal+objects"``: name the category from
