@@ -4,8 +4,8 @@ A ``gift evaluate-alignment --out`` result keeps, per intent, gift-prob's LM ter
 ladder the mixed z-scores) for every test and held-out training object. The MiniLM term is cheap to recompute.
 This rebuilds each scene's relevance with the kernel's own code (``GiftProbKernel._embed_scores`` and
 ``_combine``) under each variant of the options that act *after* the LM (``embed_text``, ``weight``,
-``weighting``, ``embed_reference``, ``standardize``, ``combine``), places the train-calibrated cut with the core
-(``AlignmentScores.with_relevance``), and prints pooled F1 (train-calibrated and oracle cut), AUC and how many
+``weighting``, ``embed_reference``, ``standardize``, ``combine``, ``veto``), places the train-calibrated cut with
+the core (``AlignmentScores.with_relevance``), and prints pooled F1 (train-calibrated and oracle cut), AUC and how many
 distractors named like the goal's class (``lang`` confounds) were aligned.
 
 The variant ``default`` is the run's own options, identified by reproducing its saved decisions to 1e-5 (the script
@@ -36,7 +36,7 @@ from gift.core.metrics import binary_metrics, roc_auc  # noqa: E402
 from gift.study.sweeps import recorded_suite  # noqa: E402
 
 AFTER_LM = {"embed_text": str, "weight": float, "weighting": str, "embed_reference": str, "standardize": str,
-            "combine": str}
+            "combine": str, "veto": str}
 
 
 def parse_variant(text: str) -> tuple[str, dict]:

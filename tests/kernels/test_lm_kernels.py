@@ -437,6 +437,34 @@ def test_reliability_weighting_drops_a_term_that_inverts_the_training_labels():
         GiftProbKernel(weighting="auc")
 
 
+def test_the_lm_veto_puts_a_look_alike_the_lm_rejects_below_the_cut():
+    """veto="lm": the toothbrush here looks like a paintbrush to the MiniLM stand-in but the LM says no; with both
+    terms separating the training objects, the veto puts it below the boundary and leaves the other decisions."""
+    table = {"paintbrush": 0.9, "sketchbook": 0.8, "banana": 0.2, "coffee mug": 0.1, "crayons": 0.7,
+             "toothbrush": 0.3, "apple": 0.2}
+    vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
+           "crayons": [0.9, 0.1, 0.1], "toothbrush": [1, 0.02, 0], "apple": [0.1, 1, 0.1]}
+    rel = ("paintbrush", "sketchbook")
+
+    def scores(veto, vectors=vec):
+        k = GiftProbKernel(lm=ScriptedLM(answer=lambda m, s: category_json("art supplies"),
+                                         probs=_probs_by_name(table)),
+                           language_kernel=TableKernel(vectors), veto=veto)
+        return k.score(TEST, TRAIN, ART, rel)
+
+    plain, vetoed = scores("none"), scores("lm")
+    assert plain.details["weights"] == vetoed.details["weights"] == {"lm": 0.5, "language": 0.5}
+    assert plain.relevance[1] > 0.5 and vetoed.relevance[1] < 0.5  # the toothbrush, let in without the veto
+    assert plain.relevance[0] > 0.5 and vetoed.relevance[0] == pytest.approx(plain.relevance[0])  # crayons kept
+    assert vetoed.relevance[2] <= plain.relevance[2] < 0.5  # the apple stays out
+    assert "veto='lm'" in repr(GiftProbKernel(veto="lm")) and "veto" not in repr(GiftProbKernel())
+    # the MiniLM term separates the training objects better than the LM term: no veto
+    table["sketchbook"] = 0.15
+    assert scores("lm").relevance == pytest.approx(scores("none").relevance)
+    with pytest.raises(GiftError, match="gift-prob: veto"):
+        GiftProbKernel(veto="always")
+
+
 def test_gift_prob_gives_the_prior_cut_one_half_with_the_weight_cut_prior():
     """The train-calibrated cut of gift-prob: the leave-one-out cut averaged with 1/2 (cut_prior: its weight;
     by default 1, the scale's boundary alone)."""

@@ -255,6 +255,7 @@ CHECK = ("none", "fit", "weight", "margin", "fit-best")
 #: again with the answered objects (LM calls); ``"evidence"`` asks nothing new and weighs the answered objects
 #: as labelled evidence beside the training objects.
 RESCORE_WITH = ("ladder", "evidence")
+VETO = ("none", "lm")
 LADDER_TEXT = prompts.LADDER_TEXT  # how the ladder's questions show each object
 
 
@@ -325,8 +326,10 @@ class GiftProbKernel(RelevanceKernel):
     scene is re-scored with them, :meth:`score_with_answers`: ``"ladder"`` names the ladder again with
     them; ``"evidence"``, the default, asks the LM nothing new and counts them beside the training objects),
     ``ladder_text`` (how the ladder's questions show each object: ``"name"``, the default, or
-    ``"name+description"``). The defaults were chosen on the development suites,
-    docs/results/front_half.md (sections 10-14).
+    ``"name+description"``), ``veto`` (``"none"``, the default; ``"lm"``: when the LM term separates the training
+    objects at least as well as the MiniLM term, an object the LM term puts below the scene's mean is put below the
+    cut whatever the MiniLM term says; against look-alike distractors, front_half.md section 43). The defaults
+    were chosen on the development suites, docs/results/front_half.md (sections 10-14).
     """
 
     name: ClassVar[str] = "gift-prob"
@@ -340,7 +343,7 @@ class GiftProbKernel(RelevanceKernel):
                  select: str = "first", calibration: str = "none", cut_prior: float = 1.0,
                  ladder: str | None = None, rungs: str = "both", check: str = "fit",
                  embed_text: str = "description", ask_text: str = "both", rescore_with: str = "evidence",
-                 ladder_text: str = "name") -> None:
+                 ladder_text: str = "name", veto: str = "none") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
         if combine not in COMBINE:
@@ -379,6 +382,13 @@ class GiftProbKernel(RelevanceKernel):
         #: How the ladder's questions (:meth:`ladder`) show each object: ``"name"`` (the default) or
         #: ``"name+description"`` ("cast-iron dog (A heavy ...)"; the worked examples with descriptions too).
         self.ladder_text = ladder_text
+        if veto not in VETO:
+            raise GiftError(f"gift-prob: veto must be one of {VETO}, got {veto!r}")
+        #: ``"lm"``: in :meth:`_combine`, when the LM term's reliability on the training objects is at least the
+        #: MiniLM term's, an object whose z-scored LM term is below 0 gets the smaller of its combined score and that
+        #: z-score, so it falls below the scale's boundary (a look-alike whose description MiniLM ranks with the
+        #: members, which the LM's questions reject; front_half.md, section 42). ``"none"``: the default.
+        self.veto = veto
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
         if weighting not in WEIGHTING:
@@ -476,12 +486,15 @@ class GiftProbKernel(RelevanceKernel):
         self.calls = 0  # distinct yes/no questions sent to the LM
 
     def __repr__(self) -> str:
+        # the veto is named only when on: a run recorded before the option existed had none, as the default has
+        veto = "" if self.veto == "none" else f"veto={self.veto!r}, "
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
                 f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, rescore_with={self.rescore_with!r}, "
-                f"ladder_text={self.ladder_text!r}, standardize={self.standardize!r}, constrained={self.constrained}, "
+                f"ladder_text={self.ladder_text!r}, {veto}standardize={self.standardize!r}, "
+                f"constrained={self.constrained}, "
                 f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
                 f"calibration={self.calibration_spec!r}, "
                 f"language_kernel={'default' if self._language is None else repr(self._language)})")
@@ -1044,16 +1057,19 @@ class GiftProbKernel(RelevanceKernel):
         ref = slice(None) if self.standardize == "pooled" else slice(n_test, None)
         terms = {"lm": _zscore(lo, ref), "language": _zscore(emb, ref)}
         w = {"lm": 1.0 - self.weight, "language": self.weight}
+        idx, labels = evidence if evidence is not None else (np.zeros(0, int), np.zeros(0, bool))
+        sep = {t: separation_weight(np.concatenate([v[n_test:], v[idx]]), np.concatenate([rel, labels]))
+               for t, v in terms.items()}
         if self.weighting == "reliability":
-            idx, labels = evidence if evidence is not None else (np.zeros(0, int), np.zeros(0, bool))
-            sep = {t: separation_weight(np.concatenate([v[n_test:], v[idx]]), np.concatenate([rel, labels]))
-                   for t, v in terms.items()}
             scaled = {t: w[t] * sep[t] for t in terms}
             if not any(math.isnan(v) for v in scaled.values()) and sum(scaled.values()) > 0:
                 w = scaled
         total = sum(w.values())
         weights = {t: v / total for t, v in w.items()}
-        return sum(weights[t] * terms[t] for t in terms), weights
+        z = sum(weights[t] * terms[t] for t in terms)
+        if self.veto == "lm" and sep["lm"] >= sep["language"]:  # False when either is nan (no evidence)
+            z = np.where(terms["lm"] < 0.0, np.minimum(z, terms["lm"]), z)
+        return z, weights
 
     def _ladder_views(self, details: dict[str, Any], emb: np.ndarray, rel: np.ndarray, n_test: int,
                       evidence: tuple[np.ndarray, np.ndarray] | None = None) -> None:
