@@ -63,6 +63,7 @@ ROLES: dict[str, str] = {
     "gift-dev21": "blind; reported only",
     "gift-dev22": "blind; the name rung not adopted",
     "gift-dev23": "blind; reported only",
+    "gift-dev24": "blind; `veto=\"lm\"` not adopted",
 }
 
 
@@ -141,6 +142,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev22", "ground-truth", F + "gift-dev22-ground-truth.json"),
     Run("gift-dev23", "inferred", F + "gift-dev23-inferred.json"),
     Run("gift-dev23", "ground-truth", F + "gift-dev23-ground-truth.json"),
+    Run("gift-dev24", "inferred", F + "gift-dev24-inferred.json"),
+    Run("gift-dev24", "ground-truth", F + "gift-dev24-ground-truth.json"),
 )
 
 
