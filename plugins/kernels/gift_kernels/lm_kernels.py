@@ -387,7 +387,9 @@ class GiftProbKernel(RelevanceKernel):
         #: ``"lm"``: in :meth:`_combine`, when the LM term's reliability on the training objects is at least the
         #: MiniLM term's, an object whose z-scored LM term is below 0 gets the smaller of its combined score and that
         #: z-score, so it falls below the scale's boundary (a look-alike whose description MiniLM ranks with the
-        #: members, which the LM's questions reject; front_half.md, section 42). ``"none"``: the default.
+        #: members, which the LM's questions reject; front_half.md, section 42). ``"none"``: the default; "lm" was
+        #: not adopted on the blind gift-dev24 (-0.001 pooled F1 over both intent sources where its rule asked for
+        #: +0.010; section 43).
         self.veto = veto
         if standardize not in STANDARDIZE:
             raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
