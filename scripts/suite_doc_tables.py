@@ -63,6 +63,8 @@ DEV24_LABEL = {"cherries": "a1a", "frog_shaped_things": "a1b", "pizzas": "a2a", 
                "netball_kit": "a3a", "trivial_pursuit_kit": "a3b", "meteorites": "a4a", "mexican_things": "a4b"}
 DEV25_LABEL = {"figs": "b1a", "house_shaped_things": "b1b", "burgers": "b2a", "crocheted_things": "b2b",
                "pickleball_kit": "b3a", "catan_kit": "b3b", "butterflies": "b4a", "signalling_things": "b4b"}
+DEV26_LABEL = {"salmon": "c1a", "pineapple_shaped_things": "c1b", "aubergines": "c2a", "hand_painted_things": "c2b",
+               "hurling_kit": "c3a", "bridge_kit": "c3b", "sea_glass": "c4a", "practical_joke_things": "c4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -117,7 +119,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev15": DEV15_LABEL, "gift-dev16": DEV16_LABEL, "gift-dev17": DEV17_LABEL,
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
-                    "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL}
+                    "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
+                    "gift-dev26": DEV26_LABEL}
 
 
 def main() -> None:
