@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24`` and ``gift-dev25``: new intents and
-objects, none borrowed from the suites they are checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25`` and ``gift-dev26``: new
+intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -319,6 +319,26 @@ DEV_SUITES = {
                        r"|birdwing|monarch|brimstone|tortoiseshell|fritillar|papilio"
                        r"|signal|\bsos\b|mayday|distress|semaphore|\bmorse\b|heliograph|aldis|thunderer|\bbeacons?\b"
                        r"|\bflares?\b|\bwhistl",
+    },
+    "gift-dev26": {
+        "siblings": [("salmon", "pineapple_shaped_things"), ("aubergines", "hand_painted_things"),
+                     ("hurling_kit", "bridge_kit"), ("sea_glass", "practical_joke_things")],
+        "label_words": r"salmon|sockeye|\bcoho\b|chinook|\bketa\b|gravad|gravlax|\blox\b|\bgrilse\b|\bsmolts?\b"
+                       r"|pineapple|\bananas\b|\bpi[nñ]as?\b|bromeliad|spongebob"
+                       r"|aubergin|eggplant|brinjal|melanzan|baingan|listada|rosa bianca|black beaut|moussaka"
+                       r"|baba.?g[hn]a?noush"
+                       r"|\bpaint|hand-?decorat|\bbrush|rosemal|zhostovo|khokhlom|bargeware|roses and castles|\btole\b"
+                       r"|watercolou?r|gouache|\bacrylics?\b"
+                       r"|hurl|sliotar|\bcam[aá]ns?\b|camogie|\bgaa\b|mycro|\bbas\b|\bbos\b|croke park|all-ireland"
+                       r"|\bpuck"
+                       r"|\bbridge|bidding|\bbids?\b|\bacol\b|duplicate|convention cards?|stayman|blackwood|\bdummy\b"
+                       r"|vulnerab|\bslams?\b|\btrumps?\b"
+                       r"|sea.?glass|beach.?glass|mermaid|seaham|\bmultis?\b|\bsea\b|\bbeach|\bshores?\b|tideline"
+                       r"|\bcoast(?:s|al)?\b"
+                       r"|practical jok|\bjok(?:e|es|er|ers|ing|ey)\b|prank|\bgags?\b|\bhoax|\bfool(?:s|ed|ing)?\b"
+                       r"|whoopee"
+                       r"|\bbuzzers?\b|dribble glass|black.?eye|stink.?bomb|itching powder|sneezing powder|\btricks?\b"
+                       r"|\bjapes?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
