@@ -82,6 +82,10 @@ class Run:
     note: str = ""
 
 
+#: Options added after some runs were recorded, with the value that is what those runs did (so a run without the
+#: option does not differ from a default that has this value).
+BEFORE: dict[str, str] = {"veto": "'none'"}
+
 F = "front_half/"
 #: What is known of runs that predate the recorded kernel options (front_half.md, sections 19 and 20).
 OLD = 'before `embed_text="description"` (2026-12-03) and `ask_text="both"` (2026-12-04)'
@@ -222,7 +226,8 @@ def row(run: Run, default: Mapping[str, str]) -> dict:
     else:
         got = parse_configuration(conf)
         diff = [f"{k}={got[k]}" for k in default if k in got and got[k] != default[k]]
-        missing = [k for k in default if k not in got]
+        # an option added later whose default is what runs made before it did is not a difference
+        missing = [k for k in default if k not in got and BEFORE.get(k) != default[k]]
         differs = ", ".join(diff + ([f"no {', '.join(missing)} yet"] if missing else [])) or "–"
     man = res.get("manifest") or {}
     started = ((man.get("runs") or [{}])[0].get("started") or "")[:10]

@@ -457,7 +457,7 @@ def test_the_lm_veto_puts_a_look_alike_the_lm_rejects_below_the_cut():
     assert plain.relevance[1] > 0.5 and vetoed.relevance[1] < 0.5  # the toothbrush, let in without the veto
     assert plain.relevance[0] > 0.5 and vetoed.relevance[0] == pytest.approx(plain.relevance[0])  # crayons kept
     assert vetoed.relevance[2] <= plain.relevance[2] < 0.5  # the apple stays out
-    assert "veto='lm'" in repr(GiftProbKernel(veto="lm")) and "veto" not in repr(GiftProbKernel())
+    assert "veto='lm'" in repr(GiftProbKernel(veto="lm")) and "veto='none'" in repr(GiftProbKernel())
     # the MiniLM term separates the training objects better than the LM term: no veto
     table["sketchbook"] = 0.15
     assert scores("lm").relevance == pytest.approx(scores("none").relevance)

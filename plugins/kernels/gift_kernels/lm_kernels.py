@@ -488,14 +488,12 @@ class GiftProbKernel(RelevanceKernel):
         self.calls = 0  # distinct yes/no questions sent to the LM
 
     def __repr__(self) -> str:
-        # the veto is named only when on: a run recorded before the option existed had none, as the default has
-        veto = "" if self.veto == "none" else f"veto={self.veto!r}, "
         return (f"GiftProbKernel(template={self.template!r}, use_descriptions={self.use_descriptions}, "
                 f"axes={self.axes}, combine={self.combine!r}, embed_reference={self.embed_reference!r}, "
                 f"weight={self.weight}, weighting={self.weighting!r}, category_from={self.category_from!r}, "
                 f"cut_prior={self.cut_prior}, ladder={self.ladder_mode!r}, rungs={self.rungs!r}, check={self.check!r}, "
                 f"embed_text={self.embed_text!r}, ask_text={self.ask_text!r}, rescore_with={self.rescore_with!r}, "
-                f"ladder_text={self.ladder_text!r}, {veto}standardize={self.standardize!r}, "
+                f"ladder_text={self.ladder_text!r}, veto={self.veto!r}, standardize={self.standardize!r}, "
                 f"constrained={self.constrained}, "
                 f"candidates={self.candidates!r}, candidate_terms={self.candidate_terms}, select={self.select!r}, "
                 f"calibration={self.calibration_spec!r}, "
