@@ -14,7 +14,7 @@ recomputation is then not the kernel's) and then scores, with the train-calibrat
 - ``lm veto``: the default combination, but an object whose z-scored LM term is below a level is left out whatever
   the MiniLM term says (front_half.md, section 42: the look-alike distractors get in on the MiniLM term).
 
-Prints pooled train-calibrated F1 per suite for every variant, the mean, and wins / losses against the saved runs;
+Prints pooled train-calibrated F1 per run for every variant, the mean, and wins / losses against the saved runs;
 ``--kinds`` prints instead, per run, how many test objects of each kind (members, distractors named like members,
 ones that look like members, the others) the saved decisions let in and how many each term alone puts above its
 scene's mean.
