@@ -465,6 +465,32 @@ def test_the_lm_veto_puts_a_look_alike_the_lm_rejects_below_the_cut():
         GiftProbKernel(veto="always")
 
 
+def test_the_prototype_reference_prefers_an_object_like_every_member_to_one_like_a_single_member():
+    """embed_reference="prototype": the mean cosine to the relevant training objects less the mean to the others
+    (``[n]``); the toothbrush, a near copy of the paintbrush alone, outranks the crayons under the nearest-member
+    reference and falls below them under the prototype."""
+    vec = {"paintbrush": [1, 0, 0, 0], "sketchbook": [0, 1, 0, 0], "banana": [0, 0, 1, 0], "coffee mug": [0, 0, 0, 1],
+           "crayons": [0.7, 0.7, 0.1, 0.1], "toothbrush": [1, 0.05, 0.05, 0.05], "apple": [0.1, 0.1, 1, 0.1]}
+    rel = np.array([True, True, False, False])
+
+    def emb(reference):
+        k = GiftProbKernel(language_kernel=TableKernel(vec), embed_reference=reference)
+        return k._embed_scores(TEST, TRAIN, rel, exclude_self=False)
+
+    unit = {n: np.asarray(v, float) / np.linalg.norm(v) for n, v in vec.items()}
+    want = [np.mean([unit[t] @ unit[m] for m in ("paintbrush", "sketchbook")])
+            - np.mean([unit[t] @ unit[o] for o in ("banana", "coffee mug")])
+            for t in ("crayons", "toothbrush", "apple")]
+    proto, nearest = emb("prototype"), emb("contrastive")
+    assert proto == pytest.approx(want)
+    assert nearest[1] > nearest[0] and proto[0] > proto[1] > proto[2]
+    # leave-one-out on the training objects: a relevant object is compared with the other relevant one only
+    loo = GiftProbKernel(language_kernel=TableKernel(vec), embed_reference="prototype")._embed_scores(
+        TRAIN, TRAIN, rel, exclude_self=True)
+    assert loo[0] == pytest.approx(0.0 - 0.0) and loo.shape == (4,)
+    assert "embed_reference='prototype'" in repr(GiftProbKernel(embed_reference="prototype"))
+
+
 def test_gift_prob_gives_the_prior_cut_one_half_with_the_weight_cut_prior():
     """The train-calibrated cut of gift-prob: the leave-one-out cut averaged with 1/2 (cut_prior: its weight;
     by default 1, the scale's boundary alone)."""

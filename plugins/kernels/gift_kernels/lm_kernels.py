@@ -234,7 +234,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 
 
 COMBINE = ("none", "language")
-EMBED_REFERENCE = ("relevant", "contrastive")
+EMBED_REFERENCE = ("relevant", "contrastive", "prototype")
 EMBED_TEXT = ("name+description", "description")
 #: ``ask_text``: one form of :data:`gift_kernels.prompts.OBJECT_TEXT`, or several combined (:data:`ASK_FORMS`).
 ASK_TEXT = (*prompts.OBJECT_TEXT, "both", "all", "both&name")
@@ -299,7 +299,9 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object), ``embed_text`` (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``),
+    object; ``"prototype"``: the mean cosine to the relevant training objects minus the mean to the others, so
+    an object must resemble the class, not one member), ``embed_text`` (what MiniLM embeds: ``"description"``,
+    the default, or ``"name+description"``),
     ``ask_text`` (how the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds
     of the question with the name and the one with the description alone; ``"name+description"``;
     ``"description"``; ``"name"``; ``"all"``, the mean of those three; ``"both&name"``, the smaller of "both"'s
@@ -816,8 +818,9 @@ class GiftProbKernel(RelevanceKernel):
     def _embed_scores(self, objs: Sequence[ObjectSpec], train: Sequence[ObjectSpec], rel: np.ndarray,
                       exclude_self: bool | np.ndarray) -> np.ndarray:
         """Description similarity of each object to the relevant training objects (``[n]``), less (contrastive)
-        that to the others. ``exclude_self``: True when ``objs`` is ``train`` (each object's own pair left out),
-        or a bool mask ``[n, n_train]`` of the pairs left out."""
+        that to the others: the nearest object's cosine on each side, or (``embed_reference="prototype"``) the
+        mean cosine over each side. ``exclude_self``: True when ``objs`` is ``train`` (each object's own pair
+        left out), or a bool mask ``[n, n_train]`` of the pairs left out."""
         sim = np.asarray(self.language.similarity(list(objs), list(train)), dtype=float)
         if isinstance(exclude_self, np.ndarray):
             sim[exclude_self] = np.nan
@@ -825,10 +828,11 @@ class GiftProbKernel(RelevanceKernel):
             np.fill_diagonal(sim, np.nan)
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows (no partner left) become 0 below
-            pos = np.nanmax(np.where(rel[None, :], sim, np.nan), axis=1) if rel.any() else np.zeros(len(objs))
+            pool = np.nanmean if self.embed_reference == "prototype" else np.nanmax
+            pos = pool(np.where(rel[None, :], sim, np.nan), axis=1) if rel.any() else np.zeros(len(objs))
             out = pos
-            if self.embed_reference == "contrastive" and (~rel).any():
-                out = pos - np.nanmax(np.where(~rel[None, :], sim, np.nan), axis=1)
+            if self.embed_reference != "relevant" and (~rel).any():
+                out = pos - pool(np.where(~rel[None, :], sim, np.nan), axis=1)
         return np.nan_to_num(out, nan=0.0)
 
     # ------------------------------------------------------------------ kernel API
