@@ -1053,7 +1053,9 @@ def test_gift_prob_answers_as_evidence_are_references_of_the_minilm_term_and_wei
     vec = {"paintbrush": [1, 0, 0], "sketchbook": [0.9, 0.1, 0], "banana": [0, 1, 0], "coffee mug": [0, 0.2, 1],
            "crayons": [0.95, 0.05, 0], "toothbrush": [0.8, 0, 0.6], "apple": [0, 1, 0.1]}
     lm = ScriptedLM(answer=lambda m, s: category_json("art supplies"), probs=_probs_by_name(table))
-    k = GiftProbKernel(lm=lm, language_kernel=TableKernel(vec), rescore_with="evidence")
+    # the nearest-reference MiniLM term, where one answered object moves a score visibly (the default's mean
+    # reference takes the same references: test_queries_lm.py checks it on the real kernel)
+    k = GiftProbKernel(lm=lm, language_kernel=TableKernel(vec), rescore_with="evidence", embed_reference="contrastive")
     rel = ("paintbrush", "sketchbook")
     base = k.score(TEST, TRAIN, ART, rel)
     n_calls = len(lm.calls)

@@ -184,13 +184,15 @@ def test_answers_as_evidence_re_score_the_real_scene_without_asking_the_lm(scene
         want = roc_auc(np.concatenate([lo_train, v[idx]]), np.concatenate([rel, [answered[TEST[i]] for i in idx]]))
         assert auc == pytest.approx(want)
     assert kernel.calls == calls  # the in-sample questions were remembered from the first scoring
-    # MiniLM: contrastive similarity to the training objects and the answered objects, never to itself
+    # MiniLM (the default reference, "prototype"): mean similarity to the relevant training and answered objects
+    # less that to the others, never to itself
     refs = list(train) + [test[i] for i in idx]
     ref_rel = np.concatenate([rel, [answered[TEST[i]] for i in idx]])
     sim = np.asarray(kernel.language.similarity(list(test), refs), dtype=float)
     for j, i in enumerate(idx):
         sim[i, len(train) + j] = np.nan
-    want = np.nanmax(np.where(ref_rel, sim, np.nan), axis=1) - np.nanmax(np.where(~ref_rel, sim, np.nan), axis=1)
+    assert kernel.embed_reference == "prototype"
+    want = np.nanmean(np.where(ref_rel, sim, np.nan), axis=1) - np.nanmean(np.where(~ref_rel, sim, np.nan), axis=1)
     assert np.allclose(det["terms"]["language"]["test"], want)
     for i, t in enumerate(TEST):
         a = after.answer_of(t)

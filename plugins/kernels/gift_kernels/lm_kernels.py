@@ -288,7 +288,8 @@ class GiftProbKernel(RelevanceKernel):
     from the goal and the training objects the demonstrations treat as part of it (one few-shot call per
     intent, plus one per training object with that object left out; :meth:`category`), then answers per
     object "is a <object> (<description>) one of the <category>?"; the log-odds and a contrastive MiniLM similarity
-    of the descriptions (without the names) are z-scored and averaged, each weighted by how well it separates the relevant training
+    of the descriptions (without the names; the mean cosine to the relevant training objects less the mean to the
+    others) are z-scored and averaged, each weighted by how well it separates the relevant training
     objects from the others (leave-one-out; ``weighting="reliability"``). ``calibration="pooled"`` instead
     puts both terms through one logistic model fitted on pooled development-suite intents and updated with
     this intent's relevant training objects (cut 1/2); measured better with true intents, worse with
@@ -299,8 +300,8 @@ class GiftProbKernel(RelevanceKernel):
     ``combine`` (``"language"``: average the z-scored log-odds with z-scored MiniLM description
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
-    object; ``"prototype"``: the mean cosine to the relevant training objects minus the mean to the others, so
-    an object must resemble the class, not one member), ``embed_text`` (what MiniLM embeds: ``"description"``,
+    object; ``"prototype"``, the default since 2026-12-07: the mean cosine to the relevant training objects
+    minus the mean to the others, so an object must resemble the class, not one member), ``embed_text`` (what MiniLM embeds: ``"description"``,
     the default, or ``"name+description"``),
     ``ask_text`` (how the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds
     of the question with the name and the one with the description alone; ``"name+description"``;
@@ -338,7 +339,7 @@ class GiftProbKernel(RelevanceKernel):
     uses_intent: ClassVar[bool] = True
 
     def __init__(self, lm: LMBackend | str | None = None, template: str = "category", use_descriptions: bool = True,
-                 axes: bool = False, combine: str = "language", embed_reference: str = "contrastive",
+                 axes: bool = False, combine: str = "language", embed_reference: str = "prototype",
                  weight: float = 0.5, standardize: str = "pooled", weighting: str = "reliability",
                  category_from: str = "goal+objects", language_kernel: SimilarityKernel | None = None,
                  constrained: bool = True, candidates: str = "text", candidate_terms: bool = False,
