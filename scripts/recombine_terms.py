@@ -74,10 +74,12 @@ def _relevance(opts: dict, lo: np.ndarray, test: list, train: list, rel: np.ndar
     return _sigmoid(k._combine(lo, emb, rel, len(test))[0])
 
 
-#: What "gift-prob" has meant after the LM: the current defaults, and before the default of ``embed_text`` became
-#: ``"description"`` (docs/results/front_half.md, section 19) ``"name+description"``. A run's options are
-#: identified by reproducing its saved decisions.
-RUN_DEFAULTS = ({}, {"embed_text": "name+description"})
+#: What "gift-prob" has meant after the LM: the current defaults; before ``embed_reference`` became ``"prototype"``
+#: (2026-12-07, docs/results/front_half.md, section 44) ``"contrastive"``; before the default of ``embed_text``
+#: became ``"description"`` (section 19) also ``"name+description"``. A run's options are identified by
+#: reproducing its saved decisions.
+RUN_DEFAULTS = ({}, {"embed_reference": "contrastive"},
+                {"embed_reference": "contrastive", "embed_text": "name+description"})
 
 
 def rescore(path: str, variants: list[tuple[str, dict]], kernel: str | None = None) -> dict[str, dict]:
