@@ -64,6 +64,7 @@ ROLES: dict[str, str] = {
     "gift-dev22": "blind; the name rung not adopted",
     "gift-dev23": "blind; reported only",
     "gift-dev24": "blind; `veto=\"lm\"` not adopted",
+    "gift-dev25": "blind; `embed_reference=\"prototype\"` adopted",
 }
 
 
@@ -148,6 +149,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev23", "ground-truth", F + "gift-dev23-ground-truth.json"),
     Run("gift-dev24", "inferred", F + "gift-dev24-inferred.json"),
     Run("gift-dev24", "ground-truth", F + "gift-dev24-ground-truth.json"),
+    Run("gift-dev25", "inferred", F + "gift-dev25-inferred.json"),
+    Run("gift-dev25", "ground-truth", F + "gift-dev25-ground-truth.json"),
 )
 
 
