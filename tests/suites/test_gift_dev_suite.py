@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25`` and ``gift-dev26``: new
-intents and objects, none borrowed from the suites they are checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26`` and
+``gift-dev27``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -339,6 +339,23 @@ DEV_SUITES = {
                        r"|whoopee"
                        r"|\bbuzzers?\b|dribble glass|black.?eye|stink.?bomb|itching powder|sneezing powder|\btricks?\b"
                        r"|\bjapes?\b",
+    },
+    "gift-dev27": {
+        "siblings": [("grapes", "elephant_shaped_things"), ("asparagus", "hessian_things"),
+                     ("croquet_kit", "risk_kit"), ("antlers", "scottish_things")],
+        "label_words": r"\bgrapes?\b|grapevine|\bvines?\b|vineyard|\bvitis\b|thompson seedless|crimson seedless|muscat"
+                       r"|moscato|concord|sultana|raisin"
+                       r"|elephant|\bdumbo\b|\bbabar\b|\belmer\b|\bjumbo\b|heffalump|pachyderm|\btrunks?\b|\btusks?\b"
+                       r"|\bivory\b|ganesh"
+                       r"|asparag|\bsprue\b|spargel|argenteuil|violetto|albenga|\bspears?\b"
+                       r"|hessian|burlap|gunny|\bjute\b|sackcloth|\bsacking\b"
+                       r"|croquet|\broquet|deadness|\bjaques\b|\bwickets?\b"
+                       r"|\brisk|hasbro|parker brothers|kamchatka|irkutsk|yakutsk|world (?:conquest|domination)"
+                       r"|antler|\bsheds?\b|\btines?\b|\bstags?\b|\bdeer\b|reindeer|\bmoose\b|\belks?\b|caribou|\broe\b"
+                       r"|\bfallow\b|\bwapiti\b|\bsika\b|\bcast\b"
+                       r"|scot|caledonia|\bhighlands?\b|\bhebrid|glasgow|edinburgh|aberdeen|dundee|inverness|\bharris\b"
+                       r"|shetland|orkney|thistle|tartan|saltire|\bloch\b|\bclans?\b|irn-?bru|tunnock|\bquaich|sporran"
+                       r"|\bkilts?\b|\bceilidh|\bbagpipe|\bpipers?\b",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
