@@ -65,6 +65,7 @@ ROLES: dict[str, str] = {
     "gift-dev23": "blind; reported only",
     "gift-dev24": "blind; `veto=\"lm\"` not adopted",
     "gift-dev25": "blind; `embed_reference=\"prototype\"` adopted",
+    "gift-dev26": "blind; reported only (first run at `embed_reference=\"prototype\"`)",
 }
 
 
@@ -151,6 +152,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev24", "ground-truth", F + "gift-dev24-ground-truth.json"),
     Run("gift-dev25", "inferred", F + "gift-dev25-inferred.json"),
     Run("gift-dev25", "ground-truth", F + "gift-dev25-ground-truth.json"),
+    Run("gift-dev26", "inferred", F + "gift-dev26-inferred.json"),
+    Run("gift-dev26", "ground-truth", F + "gift-dev26-ground-truth.json"),
 )
 
 
@@ -269,8 +272,9 @@ def query_rows(path: Path = CURVES) -> list[dict]:
             sources = re.search(r"--intent-sources (\S+)", cmd)
             if run["intent_source"] not in (sources.group(1).split(",") if sources else ["ground-truth"]):
                 continue
-            if re.search(rf"--suites (\S*/)?{re.escape(suite)}(\.yaml)?(\s|,|$)", cmd) or (
-                    suite == "lm-dev" and "lm_dev_suite" in cmd):
+            listed = re.search(r"--suites (\S+)", cmd)
+            names = {Path(x).name.removesuffix(".yaml") for x in (listed.group(1).split(",") if listed else [])}
+            if suite in names or (suite == "lm-dev" and "lm_dev_suite" in cmd):
                 commit = part["git"]["commit"][:7]
         out.append({"suite": suite, "source": run["intent_source"], "f1_0": run["curves"]["random"]["f1"][0],
                     "best": tgt["best"], "f1_2": two["f1"], "random_2": run["curves"]["random"]["f1"][k2],
