@@ -78,3 +78,12 @@ def test_a_row_pools_counts_replaces_a_rerun_intent_and_names_what_differs(mod, 
     suite.write_text(suite.read_text(encoding="utf-8") + "\n# edited\n", encoding="utf-8")
     with pytest.raises(GiftError, match="has changed since the run"):
         mod.row(mod.Run("tiny", "inferred", "main.json"), default)
+
+
+def test_every_query_row_names_the_commit_of_the_curves_run_that_listed_its_suite(mod):
+    # a curves run over several suites (``--suites gift-dev25,gift-dev26``) made the rows of each of them
+    rows = mod.query_rows()
+    assert rows and all(r["commit"] != "not recorded" for r in rows), [r["suite"] for r in rows
+                                                                      if r["commit"] == "not recorded"]
+    by_suite = {(r["suite"], r["source"]): r["commit"] for r in rows}
+    assert by_suite[("gift-dev25", "inferred")] == by_suite[("gift-dev26", "ground-truth")]
