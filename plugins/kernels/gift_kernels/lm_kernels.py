@@ -301,8 +301,8 @@ class GiftProbKernel(RelevanceKernel):
     similarity; ``"none"``: the log-odds alone), ``embed_reference`` (``"relevant"``: the largest cosine
     to a relevant training object; ``"contrastive"``: that minus the largest cosine to another training
     object; ``"prototype"``, the default since 2026-12-07: the mean cosine to the relevant training objects
-    minus the mean to the others, so an object must resemble the class, not one member), ``embed_text`` (what MiniLM embeds: ``"description"``,
-    the default, or ``"name+description"``),
+    minus the mean to the others, so an object must resemble the class, not one member), ``embed_text``
+    (what MiniLM embeds: ``"description"``, the default, or ``"name+description"``),
     ``ask_text`` (how the LM's yes/no questions show each object: ``"both"``, the default, the mean log-odds
     of the question with the name and the one with the description alone; ``"name+description"``;
     ``"description"``; ``"name"``; ``"all"``, the mean of those three; ``"both&name"``, the smaller of "both"'s
