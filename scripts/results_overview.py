@@ -66,6 +66,7 @@ ROLES: dict[str, str] = {
     "gift-dev24": "blind; `veto=\"lm\"` not adopted",
     "gift-dev25": "blind; `embed_reference=\"prototype\"` adopted",
     "gift-dev26": "blind; reported only (first run at `embed_reference=\"prototype\"`)",
+    "gift-dev27": "blind; reported only",
 }
 
 
@@ -154,6 +155,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev25", "ground-truth", F + "gift-dev25-ground-truth.json"),
     Run("gift-dev26", "inferred", F + "gift-dev26-inferred.json"),
     Run("gift-dev26", "ground-truth", F + "gift-dev26-ground-truth.json"),
+    Run("gift-dev27", "inferred", F + "gift-dev27-inferred.json"),
+    Run("gift-dev27", "ground-truth", F + "gift-dev27-ground-truth.json"),
 )
 
 
