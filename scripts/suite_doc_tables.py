@@ -67,6 +67,8 @@ DEV26_LABEL = {"salmon": "c1a", "pineapple_shaped_things": "c1b", "aubergines": 
                "hurling_kit": "c3a", "bridge_kit": "c3b", "sea_glass": "c4a", "practical_joke_things": "c4b"}
 DEV27_LABEL = {"grapes": "α1a", "elephant_shaped_things": "α1b", "asparagus": "α2a", "hessian_things": "α2b",
                "croquet_kit": "α3a", "risk_kit": "α3b", "antlers": "α4a", "scottish_things": "α4b"}
+DEV28_LABEL = {"blackberries": "β1a", "lighthouse_shaped_things": "β1b", "okra": "β2a", "terracotta_things": "β2b",
+               "polo_kit": "β3a", "battleship_kit": "β3b", "skulls": "β4a", "almond_things": "β4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -122,7 +124,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev18": DEV18_LABEL, "gift-dev19": DEV19_LABEL,
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
                     "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
-                    "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL}
+                    "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL,
+                    "gift-dev28": DEV28_LABEL}
 
 
 def main() -> None:
