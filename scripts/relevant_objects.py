@@ -35,7 +35,7 @@ DEFAULT_SUITES = ("gift-paper", "tests/kernels/data/lm_dev_suite.yaml", "gift-de
                   "gift-dev4", "gift-dev5", "gift-dev6", "gift-dev7", "gift-dev8", "gift-dev9", "gift-dev10",
                   "gift-dev11", "gift-dev12", "gift-dev13", "gift-dev14", "gift-dev15", "gift-dev16", "gift-dev17",
                   "gift-dev18", "gift-dev19", "gift-dev20", "gift-dev21", "gift-dev22",
-                  "gift-dev23", "gift-dev24", "gift-dev25", "gift-dev26", "gift-dev27")
+                  "gift-dev23", "gift-dev24", "gift-dev25", "gift-dev26", "gift-dev27", "gift-dev28")
 
 
 def _commit() -> str:

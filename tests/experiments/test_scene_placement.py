@@ -55,7 +55,7 @@ def _rq3_objects(spec) -> list[str]:
                                         "gift-dev12", "gift-dev13", "gift-dev14", "gift-dev15", "gift-dev16",
                                         "gift-dev17", "gift-dev18", "gift-dev19", "gift-dev20", "gift-dev21",
                                         "gift-dev22", "gift-dev23", "gift-dev24", "gift-dev25", "gift-dev26",
-                                        "gift-dev27", "gift-paper"])
+                                        "gift-dev27", "gift-dev28", "gift-paper"])
 @pytest.mark.parametrize("robot", ["jaco", "franka"])
 def test_every_scene_of_reproduce_is_placed_with_every_action_in_reach(suite_name, robot):
     """Training, RQ1 and RQ3 scenes of every intent, picked as reproduce picks them (its seeds): each fits on

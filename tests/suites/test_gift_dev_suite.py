@@ -1,8 +1,8 @@
 """The shipped development suites ``gift-dev``, ``gift-dev2``, ``gift-dev3``, ``gift-dev4``, ``gift-dev5``,
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
-``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26`` and
-``gift-dev27``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
+``gift-dev27`` and ``gift-dev28``: new intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -356,6 +356,20 @@ DEV_SUITES = {
                        r"|scot|caledonia|\bhighlands?\b|\bhebrid|glasgow|edinburgh|aberdeen|dundee|inverness|\bharris\b"
                        r"|shetland|orkney|thistle|tartan|saltire|\bloch\b|\bclans?\b|irn-?bru|tunnock|\bquaich|sporran"
                        r"|\bkilts?\b|\bceilidh|\bbagpipe|\bpipers?\b",
+    },
+    "gift-dev28": {
+        "siblings": [("blackberries", "lighthouse_shaped_things"), ("okra", "terracotta_things"),
+                     ("polo_kit", "battleship_kit"), ("skulls", "almond_things")],
+        "label_words": r"blackberr|\bbrambles?\b|marionberr|chester thornless|\brubus\b|dewberr|boysenberr|loganberr"
+                       r"|tayberr"
+                       r"|lighthouse|\bpharos\b|smeaton|eddystone|hatteras|fastnet|\bbeacons?\b|lightship"
+                       r"|\bokra|\bbhindi|\bgombo|\bgumbo|lad(?:y|ies)'?s?.?fingers?|abelmoschus|\bbamy?ia\b|quiabo"
+                       r"|terra.?cotta|\bclay|earthenware|\bcazuelas?\b|\bdiyas?\b|impruneta"
+                       r"|\bpolo\b|\bchukk|hurlingham|\bhpa\b|polocrosse"
+                       r"|battleship|milton bradley|\bsalvo\b|you sank"
+                       r"|skull|\bcrani|braincase"
+                       r"|almond|marzipan|frangipane|orgeat|calisson|turr[oó]n|\bjijona|amarett|mandorl|persipan"
+                       r"|amandine",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
