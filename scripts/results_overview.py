@@ -95,8 +95,8 @@ OLD = 'before `embed_text="description"` (2026-12-03) and `ask_text="both"` (202
 OLD7 = 'the default before this suite\'s decision: `embed_text="name"`; before `ask_text="both"`'
 #: The latest committed run per suite and intent source (oldest suites first).
 RUNS: tuple[Run, ...] = (
-    Run("gift-paper", "inferred", F + "gift-paper-default-inferred.json"),
-    Run("gift-paper", "ground-truth", F + "gift-paper-default-ground-truth.json"),
+    Run("gift-paper", "inferred", F + "gift-paper-prototype-inferred.json"),
+    Run("gift-paper", "ground-truth", F + "gift-paper-prototype-ground-truth.json"),
     Run("lm-dev", "inferred", F + "check-margin-lm-dev-inferred.json", baselines=F + "decision-lm-dev-inferred.json"),
     Run("lm-dev", "ground-truth", F + "ladder-boundary-lm-dev-ground-truth.json", note=OLD),
     Run("gift-dev", "inferred", F + "gift-dev-default-inferred.json"),
