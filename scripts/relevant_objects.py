@@ -29,13 +29,20 @@ import numpy as np
 
 import gift
 from gift.core.demonstrations import infer_relevant_objects
+from gift.suites import SUITE_DIR
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SUITES = ("gift-paper", "tests/kernels/data/lm_dev_suite.yaml", "gift-dev", "gift-dev2", "gift-dev3",
-                  "gift-dev4", "gift-dev5", "gift-dev6", "gift-dev7", "gift-dev8", "gift-dev9", "gift-dev10",
-                  "gift-dev11", "gift-dev12", "gift-dev13", "gift-dev14", "gift-dev15", "gift-dev16", "gift-dev17",
-                  "gift-dev18", "gift-dev19", "gift-dev20", "gift-dev21", "gift-dev22",
-                  "gift-dev23", "gift-dev24", "gift-dev25", "gift-dev26", "gift-dev27", "gift-dev28")
+
+
+def _dev_number(name: str) -> int:
+    """``gift-dev`` 1, ``gift-devN`` N: the development suites in the order they were written."""
+    return int(name.removeprefix("gift-dev") or 1)
+
+
+#: ``gift-paper``, ``lm-dev`` and every development suite shipped in ``gift/suites`` (what the built-in plugin
+#: registers), so a new suite needs no entry here.
+DEFAULT_SUITES = ("gift-paper", "tests/kernels/data/lm_dev_suite.yaml") + tuple(
+    sorted((p.stem for p in SUITE_DIR.glob("gift-dev*.yaml")), key=_dev_number))
 
 
 def _commit() -> str:
