@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import logging
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
 
-import numpy as np
 import pytest
 
 import gift
@@ -43,41 +45,31 @@ def test_a_pick_that_does_not_fit_is_replaced_by_the_next_pick_of_the_same_seed(
 
 #: Every suite shipped in ``gift/suites`` (what the built-in plugin registers), so a new one is checked too.
 SHIPPED = sorted(p.stem for p in SUITE_DIR.glob("*.yaml"))
+ROBOTS = ("jaco", "franka")
+CHECK = "test_every_scene_of_reproduce_is_placed_with_every_action_in_reach"
 
 
-def _rq3_objects(spec) -> list[str]:
-    """The four objects :func:`gift.study.chain.rq3` places (one relevant and three confounds)."""
-    rel = [t.object for t in spec.test if t.relevant]
-    conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
-        [t.object for t in spec.test if not t.relevant]
-    return (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
+@pytest.fixture(scope="module")
+def placement(request):
+    """``{(suite, robot): Future of placement_check.placement_problems}`` for the cases this session collected,
+    computed in worker processes (one per core, at most 2), in test order, so each test waits only for its own."""
+    from placement_check import placement_problems
+
+    cases = [(item.callspec.params["suite_name"], item.callspec.params["robot"]) for item in request.session.items
+             if getattr(item, "originalname", None) == CHECK]
+    workers = max(1, min(2, os.cpu_count() or 1, len(cases)))
+    # spawn: the pytest process may hold the LM's threads; a fork would copy them half-way
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        yield {case: pool.submit(placement_problems, *case) for case in cases}
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("suite_name", SHIPPED)
-@pytest.mark.parametrize("robot", ["jaco", "franka"])
-def test_every_scene_of_reproduce_is_placed_with_every_action_in_reach(suite_name, robot):
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_every_scene_of_reproduce_is_placed_with_every_action_in_reach(placement, suite_name, robot):
     """Training, RQ1 and RQ3 scenes of every intent, picked as reproduce picks them (its seeds): each fits on
     the table, and the planner reaches every candidate action, so every object is one the arm can act on
     (before the layout knew the arm's reach, jaco could not pick e.g. the paintbrush of art_supplies at
-    (0.60, -0.40) m, the only relevant object of its scene)."""
-    logging.getLogger("drake").setLevel(logging.ERROR)
-    from gift.study.chain import StudyConfig, intent_seeds
-
-    suite = gift.load_suite(suite_name)
-    cfg = StudyConfig(suite=suite_name, robot=robot)
-    sim = gift.get_simulator(f"drake-{robot}")
-    for spec in suite.intents:
-        seeds = intent_seeds(cfg, spec.id)
-        rel = list(spec.relevant_train)
-        irr = [o for o in spec.train_objects if o not in rel]
-        scenes = [place_scene(sim, suite, spec.task, rel, irr, cfg.test_objects_per_scene, s) for s in seeds["train"]]
-        scenes += [make_test_scene(sim, suite, spec, cfg.test_objects_per_scene, s) for s in seeds["rq1"]]
-        if spec.task in ("pack_backpack", "store_drawer"):
-            objects = _rq3_objects(spec)
-            relevant = [o for o in objects if o in spec.relevant_test]
-            scenes += [sim.make_scene(spec.task, suite.specs(objects), relevant, seed=s) for s in seeds["rq3"]]
-        for scene in scenes:
-            assert len(scene.objects) == cfg.test_objects_per_scene, (spec.id, scene.seed)
-            acts, _, feasible = sim.planner.prepare(scene)  # raises GiftError when the nominal is out of reach
-            assert feasible.all(), (spec.id, scene.seed, [acts.labels[a] for a in np.flatnonzero(~feasible)])
+    (0.60, -0.40) m, the only relevant object of its scene). The check is placement_check.placement_problems."""
+    problems = placement[(suite_name, robot)].result()
+    assert problems == [], "\n".join(problems)
