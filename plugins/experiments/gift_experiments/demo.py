@@ -27,10 +27,12 @@ def demo(intent: str = "art_supplies", lm: str | None = None, out: Path = Path("
     relevant = results["relevant"][intent]
     print(f"intent {intent!r}: inferred -> {intent_text!r}")
     print(f"relevant training objects ({relevant['source']}): {', '.join(relevant['names'])}")
-    print(f"{'kernel':<16} {'win rate':>9} {'F1':>6}")
     rq1, rq2 = results["rq1"][intent], results["rq2"].get(intent, {})
-    for k in [k for k in KERNEL_ORDER if k in rq1] + [k for k in rq1 if k not in KERNEL_ORDER and k != ORACLE] + [ORACLE]:
+    rows = [k for k in KERNEL_ORDER if k in rq1] + [k for k in rq1 if k not in KERNEL_ORDER and k != ORACLE] + [ORACLE]
+    width = max(16, *(len(k) for k in rows))  # kernel specs with options are longer than the names
+    print(f"{'kernel':<{width}} {'win rate':>9} {'F1':>6}")
+    for k in rows:
         f1 = rq2.get(k, {}).get("train-calibrated", {}).get("all", {}).get("f1")
-        print(f"{k:<16} {rq1[k]['mean']:>9.3f} {'' if f1 is None else f'{f1:.3f}':>6}")
+        print(f"{k:<{width}} {rq1[k]['mean']:>9.3f} {'' if f1 is None else f'{f1:.3f}':>6}")
     print(f"({elapsed:.0f} s; report.html, report.md, figures and replays in {out})")
     return 0
