@@ -2,7 +2,8 @@
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
 ``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
-``gift-dev27`` and ``gift-dev28``: new intents and objects, none borrowed from the suites they are checked against.
+``gift-dev27``, ``gift-dev28`` and ``gift-dev29``: new intents and objects, none borrowed from the suites they are
+checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -370,6 +371,18 @@ DEV_SUITES = {
                        r"|skull|\bcrani|braincase"
                        r"|almond|marzipan|frangipane|orgeat|calisson|turr[oó]n|\bjijona|amarett|mandorl|persipan"
                        r"|amandine",
+    },
+    "gift-dev29": {
+        "siblings": [("rhubarb", "cactus_shaped_things"), ("melons", "raffia_things"),
+                     ("curling_kit", "carrom_kit"), ("birds_nests", "carob_things")],
+        "label_words": r"rhubarb|\brheum\b|pie.?plant|timperley|\bvictoria\b|roobarb"
+                       r"|cact|saguaro|opuntia|prickly.?pear|golden.?barrel|organ.?pipe|cholla|cereus"
+                       r"|melon|cantaloup|honeydew|charentais|\bgalia\b|piel de sapo|\bogen\b|cucumis|citrullus"
+                       r"|raffia|raphia|rofia|\bkuba\b|\bdida\b|shoowa|rabane"
+                       r"|curl|bonspiel|\bwcf\b|little rock"
+                       r"|carr?om\b|carroms?|\bstriker|\bqueen\b|\bicf\b"
+                       r"|\bnests?\b|nesting|nestl|eyrie|\bdrey"
+                       r"|carob|ceratonia|locust bean|st\.? john's bread|kharroub|harnup|pasteli|algarrob",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
