@@ -67,6 +67,7 @@ ROLES: dict[str, str] = {
     "gift-dev25": "blind; `embed_reference=\"prototype\"` adopted",
     "gift-dev26": "blind; reported only (first run at `embed_reference=\"prototype\"`)",
     "gift-dev27": "blind; reported only",
+    "gift-dev28": "blind; reported only",
 }
 
 
@@ -157,6 +158,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev26", "ground-truth", F + "gift-dev26-ground-truth.json"),
     Run("gift-dev27", "inferred", F + "gift-dev27-inferred.json"),
     Run("gift-dev27", "ground-truth", F + "gift-dev27-ground-truth.json"),
+    Run("gift-dev28", "inferred", F + "gift-dev28-inferred.json"),
+    Run("gift-dev28", "ground-truth", F + "gift-dev28-ground-truth.json"),
 )
 
 
