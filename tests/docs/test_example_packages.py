@@ -94,28 +94,23 @@ def test_robot_package_tests_pass_on_drake(fresh_env):
     assert "3 passed" in out and "skipped" not in out, out
 
 
-#: gift-prob with one category (no ladder): the robot-specific stages stay, the LM's share shrinks
-GIFT_PROB = "gift-prob:ladder=never"
-
-
 @pytest.mark.drake
 @pytest.mark.lm
 def test_demo_runs_end_to_end_on_the_third_party_robot(fresh_env, tmp_path):
     """``gift demo --robot ur5e``: Drake demonstrations on the UR5e, intent inferred by the embedded LM,
-    alignment and win rates, at the demo's own (small) sizes. gift-prob runs without its category ladder
-    (``ladder=never``: one category instead of about six, about 100 s less on 2 cores): what is the robot's here
-    (scenes, demonstrations, the reward, Call 1's feature traces) is all still on the UR5e, and the default
-    recipe with the ladder runs on the real model in the cold demo benchmark on the Jaco."""
+    alignment and win rates, at the demo's own (small) sizes. (Its LM answers fill the session's cache, which
+    tests/study/test_inferred_separation.py then reads: without the ladder here that test took 105 s longer in
+    CI, so the default recipe stays.)"""
     help_text = fresh_env.run_py("-m", "gift.cli", "demo", "--help").stdout
     assert "ur5e" in help_text.split("--robot", 1)[1].split("\n", 1)[0]  # the choices come from the registry
     out_dir = tmp_path / "demo-ur5e"
     proc = fresh_env.run_py("-m", "gift.cli", "-q", "demo", "--robot", "ur5e", "--out", str(out_dir),
-                            "--kernels", f"vision,language,{GIFT_PROB}", timeout=3600)
+                            timeout=3600)  # 667 CPU-s from an empty cache; slower on a busy machine
     lines = proc.stdout.strip().splitlines()
     assert lines[0].startswith("intent 'art_supplies': inferred -> ")
     header = next(i for i, ln in enumerate(lines) if ln.split()[:1] == ["kernel"])
     rows = {ln.split()[0]: ln.split()[1:] for ln in lines[header + 1:-1]}
-    assert set(rows) == {"vision", "language", GIFT_PROB, "oracle-labels"}, proc.stdout
+    assert set(rows) == {"vision", "language", "gift-prob", "oracle-labels"}, proc.stdout
     for name, values in rows.items():
         assert 0.0 <= float(values[0]) <= 1.0, (name, values)
     results = json.loads((out_dir / "results.json").read_text())
