@@ -71,6 +71,8 @@ DEV28_LABEL = {"blackberries": "β1a", "lighthouse_shaped_things": "β1b", "okra
                "polo_kit": "β3a", "battleship_kit": "β3b", "skulls": "β4a", "almond_things": "β4b"}
 DEV29_LABEL = {"rhubarb": "γ1a", "cactus_shaped_things": "γ1b", "melons": "γ2a", "raffia_things": "γ2b",
                "curling_kit": "γ3a", "carrom_kit": "γ3b", "birds_nests": "γ4a", "carob_things": "γ4b"}
+DEV30_LABEL = {"peaches": "δ1a", "hedgehog_shaped_things": "δ1b", "doughnuts": "δ2a", "alpaca_things": "δ2b",
+               "lacrosse_kit": "δ3a", "carcassonne_kit": "δ3b", "teeth": "δ4a", "cassava_things": "δ4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -127,7 +129,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
                     "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
                     "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL,
-                    "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL}
+                    "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL, "gift-dev30": DEV30_LABEL}
 
 
 def main() -> None:
