@@ -2,8 +2,8 @@
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
 ``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
-``gift-dev27``, ``gift-dev28`` and ``gift-dev29``: new intents and objects, none borrowed from the suites they are
-checked against.
+``gift-dev27``, ``gift-dev28``, ``gift-dev29`` and ``gift-dev30``: new intents and objects, none borrowed from the
+suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -383,6 +383,19 @@ DEV_SUITES = {
                        r"|carr?om\b|carroms?|\bstriker|\bqueen\b|\bicf\b"
                        r"|\bnests?\b|nesting|nestl|eyrie|\bdrey"
                        r"|carob|ceratonia|locust bean|st\.? john's bread|kharroub|harnup|pasteli|algarrob",
+    },
+    "gift-dev30": {
+        "siblings": [("peaches", "hedgehog_shaped_things"), ("doughnuts", "alpaca_things"),
+                     ("lacrosse_kit", "carcassonne_kit"), ("teeth", "cassava_things")],
+        "label_words": r"peach|nectarin|prunus|persica|redhaven|elberta|paraguayo|p[eê]ches?\b|melocot"
+                       r"|hedgehog|hedgepig|erinace|tiggy|pricklepants|\burchins?\b|\bsonic\b"
+                       r"|dough.?nut|\bdonuts?\b|bombolon|sufgani|p[aą]czk|berliner|krapfen|malasada|loukoumad"
+                       r"|alpaca|\bsuri\b|huacaya|\bpaco\b|chullo"
+                       r"|lacrosse|\bcrosse|la ?crosse|lacroix|nocsae|\bncaa\b"
+                       r"|carcassonne|meeple|\bfollowers?\b|wrede"
+                       r"|teeth|tooth|\btusks?\b|\bmolars?\b|\bincisors?\b|\bfangs?\b"
+                       r"|\bdent(?:al|ine|ition)|\bcanines?\b"
+                       r"|cassava|manioc|mandioca|\byuca\b|tapioca|\bgarri\b|\bgari\b|farofa|cassareep|cassis|cassata",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
