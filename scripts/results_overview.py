@@ -68,6 +68,7 @@ ROLES: dict[str, str] = {
     "gift-dev26": "blind; reported only (first run at `embed_reference=\"prototype\"`)",
     "gift-dev27": "blind; reported only",
     "gift-dev28": "blind; reported only",
+    "gift-dev29": "blind; reported only",
 }
 
 
@@ -160,6 +161,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev27", "ground-truth", F + "gift-dev27-ground-truth.json"),
     Run("gift-dev28", "inferred", F + "gift-dev28-inferred.json"),
     Run("gift-dev28", "ground-truth", F + "gift-dev28-ground-truth.json"),
+    Run("gift-dev29", "inferred", F + "gift-dev29-inferred.json"),
+    Run("gift-dev29", "ground-truth", F + "gift-dev29-ground-truth.json"),
 )
 
 
