@@ -434,15 +434,22 @@ def win_rates(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec
     return {k: {"mean": mean_se(v)[0], "se": mean_se(v)[1], "per_seed": v} for k, v in per.items()}
 
 
+def rq3_objects(spec: IntentSpec) -> list[str]:
+    """The four held-out objects RQ3 places: one relevant and three confounds (two and two when fewer than three
+    confounds; any irrelevant object counts when none is marked as a confound)."""
+    rel = [t.object for t in spec.test if t.relevant]
+    conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
+        [t.object for t in spec.test if not t.relevant]
+    return (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
+
+
 def rq3(comp: Components, cfg: StudyConfig, suite: Suite, spec: IntentSpec, reward: Any,
         alignments: Mapping[str, Alignment], seeds: Sequence[int], progress: Progress) -> dict:
     """RQ3: four candidates, each acting on a different held-out object; Boltzmann over aligned rewards."""
     sim = comp.simulator(simulator_name(cfg.rq3_robot))
     task = comp.task(spec.task)
     rel = [t.object for t in spec.test if t.relevant]
-    conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
-        [t.object for t in spec.test if not t.relevant]
-    objects = (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
+    objects = rq3_objects(spec)
     specs = task.feature_specs(objects)
     probs: dict[str, list[np.ndarray]] = {}
     for seed in progress(seeds, f"{spec.id}: RQ3"):

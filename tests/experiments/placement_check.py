@@ -14,19 +14,11 @@ from gift.study.scenes import place_scene
 from gift.study.scenes import test_scene as make_test_scene  # not a test
 
 
-def rq3_objects(spec) -> list[str]:
-    """The four objects :func:`gift.study.chain.rq3` places (one relevant and three confounds)."""
-    rel = [t.object for t in spec.test if t.relevant]
-    conf = [t.object for t in spec.test if not t.relevant and t.confounds] or \
-        [t.object for t in spec.test if not t.relevant]
-    return (rel[:1] + conf[:3]) if len(conf) >= 3 else (rel[:2] + conf[:2])
-
-
 def placement_problems(suite_name: str, robot: str) -> list[str]:
     """What does not fit or is out of reach in the training, RQ1 and RQ3 scenes of every intent, picked with
     reproduce's seeds; ``[]`` when every scene fits on the table and the planner reaches every candidate action."""
     logging.getLogger("drake").setLevel(logging.ERROR)
-    from gift.study.chain import StudyConfig, intent_seeds
+    from gift.study.chain import StudyConfig, intent_seeds, rq3_objects
 
     suite = gift.load_suite(suite_name)
     cfg = StudyConfig(suite=suite_name, robot=robot)
