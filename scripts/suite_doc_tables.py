@@ -73,6 +73,8 @@ DEV29_LABEL = {"rhubarb": "γ1a", "cactus_shaped_things": "γ1b", "melons": "γ2
                "curling_kit": "γ3a", "carrom_kit": "γ3b", "birds_nests": "γ4a", "carob_things": "γ4b"}
 DEV30_LABEL = {"peaches": "δ1a", "hedgehog_shaped_things": "δ1b", "doughnuts": "δ2a", "alpaca_things": "δ2b",
                "lacrosse_kit": "δ3a", "carcassonne_kit": "δ3b", "teeth": "δ4a", "cassava_things": "δ4b"}
+DEV31_LABEL = {"raspberries": "ε1a", "penguin_shaped_things": "ε1b", "pancakes": "ε2a", "tweed_things": "ε2b",
+               "kendo_kit": "ε3a", "pandemic_kit": "ε3b", "geodes": "ε4a", "peanut_things": "ε4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -129,7 +131,8 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev20": DEV20_LABEL, "gift-dev21": DEV21_LABEL, "gift-dev22": DEV22_LABEL,
                     "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
                     "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL,
-                    "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL, "gift-dev30": DEV30_LABEL}
+                    "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL, "gift-dev30": DEV30_LABEL,
+                    "gift-dev31": DEV31_LABEL}
 
 
 def main() -> None:
