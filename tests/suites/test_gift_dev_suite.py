@@ -2,8 +2,8 @@
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
 ``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
-``gift-dev27``, ``gift-dev28``, ``gift-dev29`` and ``gift-dev30``: new intents and objects, none borrowed from the
-suites they are checked against.
+``gift-dev27``, ``gift-dev28``, ``gift-dev29``, ``gift-dev30`` and ``gift-dev31``: new intents and objects, none
+borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -396,6 +396,20 @@ DEV_SUITES = {
                        r"|teeth|tooth|\btusks?\b|\bmolars?\b|\bincisors?\b|\bfangs?\b"
                        r"|\bdent(?:al|ine|ition)|\bcanines?\b"
                        r"|cassava|manioc|mandioca|\byuca\b|tapioca|\bgarri\b|\bgari\b|farofa|cassareep|cassis|cassata",
+    },
+    "gift-dev31": {
+        "siblings": [("raspberries", "penguin_shaped_things"), ("pancakes", "tweed_things"),
+                     ("kendo_kit", "pandemic_kit"), ("geodes", "peanut_things")],
+        "label_words": r"raspberr|framboise|\brubus\b|idaeus|tulameen|glen ample|autumn bliss"
+                       r"|penguin|\bpingu\b|\btux\b|mcgraw|spheniscus|aptenodytes"
+                       r"|pancak|\bcr[eê]pes?\b|\bblin[iy]s?\b|poffert|hotcake|griddle ?cakes?|drop scones?|\bdosas?\b"
+                       r"|pannekoek|pfannkuchen"
+                       r"|tweed|harris|donegal|hacking|plus.?fours"
+                       r"|kendo|shinai|\bbogu\b|\bkote\b|tenugui|tsuba|zekken|\btare\b|sakigawa|hakama|keikogi|nagasaki"
+                       r"|pandemic|leacock|z-?man\b|on the brink|in the lab\b|state of emergency"
+                       r"|geod|keokuk|dugway|\bcathedrals?\b"
+                       r"|peanut|groundnut|goober|arachis|monkey ?nuts?|kuli|chikki|satay|redskin"
+                       r"|schulz|snoopy|charlie brown",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
