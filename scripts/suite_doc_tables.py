@@ -75,6 +75,8 @@ DEV30_LABEL = {"peaches": "δ1a", "hedgehog_shaped_things": "δ1b", "doughnuts":
                "lacrosse_kit": "δ3a", "carcassonne_kit": "δ3b", "teeth": "δ4a", "cassava_things": "δ4b"}
 DEV31_LABEL = {"raspberries": "ε1a", "penguin_shaped_things": "ε1b", "pancakes": "ε2a", "tweed_things": "ε2b",
                "kendo_kit": "ε3a", "pandemic_kit": "ε3b", "geodes": "ε4a", "peanut_things": "ε4b"}
+DEV32_LABEL = {"dates": "ζ1a", "cat_shaped_things": "ζ1b", "dumplings": "ζ2a", "sheepskin_things": "ζ2b",
+               "boxing_kit": "ζ3a", "wingspan_kit": "ζ3b", "crystals": "ζ4a", "hazelnut_things": "ζ4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -132,7 +134,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
                     "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL,
                     "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL, "gift-dev30": DEV30_LABEL,
-                    "gift-dev31": DEV31_LABEL}
+                    "gift-dev31": DEV31_LABEL, "gift-dev32": DEV32_LABEL}
 
 
 def main() -> None:
