@@ -2,8 +2,8 @@
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
 ``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
-``gift-dev27``, ``gift-dev28``, ``gift-dev29``, ``gift-dev30`` and ``gift-dev31``: new intents and objects, none
-borrowed from the suites they are checked against.
+``gift-dev27``, ``gift-dev28``, ``gift-dev29``, ``gift-dev30``, ``gift-dev31`` and ``gift-dev32``: new intents and
+objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -410,6 +410,24 @@ DEV_SUITES = {
                        r"|geod|keokuk|dugway|\bcathedrals?\b"
                        r"|peanut|groundnut|goober|arachis|monkey ?nuts?|kuli|chikki|satay|redskin"
                        r"|schulz|snoopy|charlie brown",
+    },
+    "gift-dev32": {
+        "siblings": [("dates", "cat_shaped_things"), ("dumplings", "sheepskin_things"),
+                     ("boxing_kit", "wingspan_kit"), ("crystals", "hazelnut_things")],
+        "label_words": r"\bdates?\b|medjool|majhool|deglet|\bajwa\b|barhi|khalal|\brutab\b|\btamr\b|mazafati|zahidi"
+                       r"|halawi|khadrawy|sukkari|dactylifera"
+                       r"|\bcats?\b|kitt(?:y|en|ens|ies)\b|feline|\bfelis\b|\bpuss(?:y|ies)?\b|\bmog(?:gy|gie)?\b|tabby"
+                       r"|maneki|\bneko\b|garfield|doraemon|miaow|meow|pusheen"
+                       r"|dumpl|gyoza|jiaozi|pierog|pelmen|\bmomos?\b|wonton|xiao ?long ?bao|khinkal|\bmandu\b|\bmanti\b"
+                       r"|varenyk|vareniki|kn[oö]del|knedl|\bbao\b|siu mai|shumai|har gow|potsticker|dim sum"
+                       r"|sheepskin|\bsheep|shearling|lambskin|\blambs?\b|\bewes?\b|\buggs?\b|mouton|sherpa"
+                       r"|boxing|\bboxers?\b|pugil|prize.?fight|lonsdale|everlast|cleto|\breyes\b|queensberry"
+                       r"|\bspar(?:s|red|ring)?\b|gum.?shield"
+                       r"|wingspan|stonemaier|hargrave|birdfeeder|european expansion|oceania expansion|wyrmspan"
+                       r"|crystal|quartz|pyrite|fluorite|selenite|tourmaline|aquamarine|amethyst|citrine|herkimer"
+                       r"|desert roses?|calcite|celestite|swarovski"
+                       r"|hazel|filbert|\bcobnuts?\b|\bcobs?\b|corylus|nocciol|gianduj|frangelico|nutella|avellan"
+                       r"|noisette|tonda gentile|giffoni|kentish|f[iı]nd[iı]k",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
