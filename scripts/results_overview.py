@@ -69,6 +69,7 @@ ROLES: dict[str, str] = {
     "gift-dev27": "blind; reported only",
     "gift-dev28": "blind; reported only",
     "gift-dev29": "blind; reported only",
+    "gift-dev30": "blind; reported only",
 }
 
 
@@ -163,6 +164,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev28", "ground-truth", F + "gift-dev28-ground-truth.json"),
     Run("gift-dev29", "inferred", F + "gift-dev29-inferred.json"),
     Run("gift-dev29", "ground-truth", F + "gift-dev29-ground-truth.json"),
+    Run("gift-dev30", "inferred", F + "gift-dev30-inferred.json"),
+    Run("gift-dev30", "ground-truth", F + "gift-dev30-ground-truth.json"),
 )
 
 
