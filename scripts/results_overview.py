@@ -70,6 +70,7 @@ ROLES: dict[str, str] = {
     "gift-dev28": "blind; reported only",
     "gift-dev29": "blind; reported only",
     "gift-dev30": "blind; reported only",
+    "gift-dev31": "blind; reported only",
 }
 
 
@@ -166,6 +167,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev29", "ground-truth", F + "gift-dev29-ground-truth.json"),
     Run("gift-dev30", "inferred", F + "gift-dev30-inferred.json"),
     Run("gift-dev30", "ground-truth", F + "gift-dev30-ground-truth.json"),
+    Run("gift-dev31", "inferred", F + "gift-dev31-inferred.json"),
+    Run("gift-dev31", "ground-truth", F + "gift-dev31-ground-truth.json"),
 )
 
 
