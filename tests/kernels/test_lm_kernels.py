@@ -1147,3 +1147,11 @@ def test_gift_prob_name_rung_joins_the_ladder_without_an_lm_call():
     # the felt pen's own ladder (named without it) has no shared word: the full rung stands in
     assert any(q.startswith("Is a felt pen (a pen with a felt tip) one of the felt things?") for q in asked)
     assert "both+names" in RUNGS
+
+
+@pytest.mark.parametrize("option", ["combine", "embed_reference", "embed_text", "ask_text", "rescore_with",
+                                    "ladder_text", "veto", "standardize", "weighting", "category_from",
+                                    "candidates", "select", "ladder", "rungs", "check"])
+def test_gift_prob_names_the_option_and_its_choices_when_a_value_is_unknown(option):
+    with pytest.raises(GiftError, match=rf"gift-prob: {option} must be one of \(.*\), got 'bogus'"):
+        GiftProbKernel(**{option: "bogus"})

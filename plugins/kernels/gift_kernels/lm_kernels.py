@@ -229,6 +229,12 @@ def _zscore(x: np.ndarray, ref: slice = slice(None)) -> np.ndarray:
     return (x - mu) / sd if sd > 1e-9 else x - mu
 
 
+def _one_of(option: str, value: object, allowed: Sequence[object]) -> None:
+    """Raise a :class:`GiftError` naming ``gift-prob``'s ``option`` unless ``value`` is one of ``allowed``."""
+    if value not in allowed:
+        raise GiftError(f"gift-prob: {option} must be one of {allowed}, got {value!r}")
+
+
 def _sigmoid(x: np.ndarray) -> np.ndarray:
     return 1.0 / (1.0 + np.exp(-np.asarray(x, dtype=float)))
 
@@ -349,20 +355,16 @@ class GiftProbKernel(RelevanceKernel):
                  ladder_text: str = "name", veto: str = "none") -> None:
         if template not in prompts.RELEVANCE_TEMPLATES:
             raise GiftError(f"gift-prob: unknown template {template!r}; one of {sorted(prompts.RELEVANCE_TEMPLATES)}")
-        if combine not in COMBINE:
-            raise GiftError(f"gift-prob: combine must be one of {COMBINE}, got {combine!r}")
-        if embed_reference not in EMBED_REFERENCE:
-            raise GiftError(f"gift-prob: embed_reference must be one of {EMBED_REFERENCE}, got {embed_reference!r}")
-        if embed_text not in EMBED_TEXT:
-            raise GiftError(f"gift-prob: embed_text must be one of {EMBED_TEXT}, got {embed_text!r}")
+        _one_of("combine", combine, COMBINE)
+        _one_of("embed_reference", embed_reference, EMBED_REFERENCE)
+        _one_of("embed_text", embed_text, EMBED_TEXT)
         #: What the MiniLM term embeds of each object: ``"description"`` (the default: the name left out, so
         #: the LM's question, which carries the name, and the MiniLM term do not both read it; a distractor
         #: named like the class is then judged by what it is) or ``"name+description"``. Chosen on gift-dev7
         #: by a rule written before it was run (train-calibrated F1 0.767 -> 0.788 pooled over both intent
         #: sources; docs/results/front_half.md, section 19).
         self.embed_text = embed_text
-        if ask_text not in ASK_TEXT:
-            raise GiftError(f"gift-prob: ask_text must be one of {ASK_TEXT}, got {ask_text!r}")
+        _one_of("ask_text", ask_text, ASK_TEXT)
         #: How each object is shown in the LM's yes/no questions (:data:`gift_kernels.prompts.OBJECT_TEXT`):
         #: ``"both"`` (the default: both questions below asked, their log-odds averaged; twice the questions),
         #: ``"name+description"``, ``"description"`` (no name: "a thing described as ...") or ``"name"`` (no
@@ -371,8 +373,7 @@ class GiftProbKernel(RelevanceKernel):
         #: gift-dev8 by a rule written before it was run (train-calibrated F1 0.825 -> 0.838 pooled over both
         #: intent sources; docs/results/front_half.md, section 20).
         self.ask_text = ask_text
-        if rescore_with not in RESCORE_WITH:
-            raise GiftError(f"gift-prob: rescore_with must be one of {RESCORE_WITH}, got {rescore_with!r}")
+        _one_of("rescore_with", rescore_with, RESCORE_WITH)
         #: What answers do when the scene is re-scored with them (:meth:`score_with_answers`; callers re-score
         #: by default, ``--no-rescore`` turns it off): ``"evidence"`` (the default: no LM call; the answered
         #: test objects join the training objects as labelled evidence in the check of the categories, the
@@ -380,13 +381,11 @@ class GiftProbKernel(RelevanceKernel):
         #: LM calls). "evidence" was chosen on gift-dev10 by a rule written before it was run (pooled F1 after
         #: 2 questions, mean over both intent sources, 0.882 -> 0.908; docs/results/queries.md).
         self.rescore_with = rescore_with
-        if ladder_text not in LADDER_TEXT:
-            raise GiftError(f"gift-prob: ladder_text must be one of {LADDER_TEXT}, got {ladder_text!r}")
+        _one_of("ladder_text", ladder_text, LADDER_TEXT)
         #: How the ladder's questions (:meth:`ladder`) show each object: ``"name"`` (the default) or
         #: ``"name+description"`` ("cast-iron dog (A heavy ...)"; the worked examples with descriptions too).
         self.ladder_text = ladder_text
-        if veto not in VETO:
-            raise GiftError(f"gift-prob: veto must be one of {VETO}, got {veto!r}")
+        _one_of("veto", veto, VETO)
         #: ``"lm"``: in :meth:`_combine`, when the LM term's reliability on the training objects is at least the
         #: MiniLM term's, an object whose z-scored LM term is below 0 gets the smaller of its combined score and that
         #: z-score, so it falls below the scale's boundary (a look-alike whose description MiniLM ranks with the
@@ -394,23 +393,17 @@ class GiftProbKernel(RelevanceKernel):
         #: not adopted on the blind gift-dev24 (-0.001 pooled F1 over both intent sources where its rule asked for
         #: +0.010; section 43).
         self.veto = veto
-        if standardize not in STANDARDIZE:
-            raise GiftError(f"gift-prob: standardize must be one of {STANDARDIZE}, got {standardize!r}")
-        if weighting not in WEIGHTING:
-            raise GiftError(f"gift-prob: weighting must be one of {WEIGHTING}, got {weighting!r}")
-        if category_from not in CATEGORY_FROM:
-            raise GiftError(f"gift-prob: category_from must be one of {CATEGORY_FROM}, got {category_from!r}")
+        _one_of("standardize", standardize, STANDARDIZE)
+        _one_of("weighting", weighting, WEIGHTING)
+        _one_of("category_from", category_from, CATEGORY_FROM)
         if not 0.0 <= float(weight) <= 1.0:
             raise GiftError(f"gift-prob: weight must be in [0, 1], got {weight!r}")
-        if candidates not in CANDIDATES:
-            raise GiftError(f"gift-prob: candidates must be one of {CANDIDATES}, got {candidates!r}")
-        if select not in SELECT:
-            raise GiftError(f"gift-prob: select must be one of {SELECT}, got {select!r}")
+        _one_of("candidates", candidates, CANDIDATES)
+        _one_of("select", select, SELECT)
         self.select = select
         if ladder is None:  # the ladder's averaged z-scores are not what a calibration was fitted on
             ladder = "inferred" if calibration == "none" else "never"
-        if ladder not in LADDER:
-            raise GiftError(f"gift-prob: ladder must be one of {LADDER}, got {ladder!r}")
+        _one_of("ladder", ladder, LADDER)
         if ladder != "never" and calibration != "none":
             raise GiftError("gift-prob: a calibration is fitted on one category's log-odds; the ladder averages "
                             "z-scores of several, so use ladder='never' with calibration")
@@ -421,8 +414,7 @@ class GiftProbKernel(RelevanceKernel):
         #: gift-dev2 and lm-dev: mean train-calibrated F1 0.764 -> 0.808 with cut_prior=1); ``"always"``;
         #: ``"never"`` (the default with a calibration).
         self.ladder_mode = ladder
-        if rungs not in RUNGS:
-            raise GiftError(f"gift-prob: rungs must be one of {RUNGS}, got {rungs!r}")
+        _one_of("rungs", rungs, RUNGS)
         #: What the ladder's rungs are: ``"breadth"``, one kind named narrow, middle and broad;
         #: ``"facets"``, the kind, the material and a property the demonstrated objects share, each possibly
         #: none (:func:`gift_kernels.prompts.facet_messages`); ``"both"``, the default: the rungs of the two
@@ -434,8 +426,7 @@ class GiftProbKernel(RelevanceKernel):
         #: other training object's ("basket things"; :func:`gift_kernels.prompts.shared_name_category`); not
         #: adopted: +0.008 inferred F1 on the blind gift-dev22 where its rule asked for +0.010 (front_half.md, 40).
         self.rungs = rungs
-        if check not in CHECK:
-            raise GiftError(f"gift-prob: check must be one of {CHECK}, got {check!r}")
+        _one_of("check", check, CHECK)
         #: How the ladder's categories (the goal's and each rung) are checked against the training objects they
         #: were named from before they are averaged: each is asked of every training object as named (in-sample)
         #: and scored by its AUC separating the demonstrated objects from the left-alone ones. ``"none"``: the
