@@ -107,6 +107,31 @@ def add_lm_timeout_argument(parser: argparse.ArgumentParser) -> None:
                                 f"(default: ${LM_TIMEOUT_ENV}, else {DEFAULT_LM_TIMEOUT_S:g} s)")
 
 
+def add_answer_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--policy NAME --abstain BAND --[no-]rescore``: how a command that asks about test objects chooses them,
+    which it flags instead of deciding, and whether the kernel re-scores with the answers."""
+    parser.add_argument("--policy", default="uncertainty", metavar="NAME",
+                        help="which test objects to ask about: uncertainty (default), disagreement, error-bound, "
+                             "expected-error, random, or another registered query policy (gift plugins)")
+    parser.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
+                        help="flag instead of decide the objects whose decision score is within BAND of the cut; "
+                             "their features are dropped like a distractor's (default 0: never)")
+    parser.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
+                        help="a kernel that can use the answers scores the scene again after each answer (the "
+                             "default; gift-prob weighs them as evidence, no LM call, or with "
+                             "gift-prob:rescore_with=ladder names its ladder again); --no-rescore: answers only "
+                             "re-threshold the first scores")
+
+
+def check_answer_arguments(args: argparse.Namespace) -> None:
+    """Raise a :class:`GiftError` for an ``--abstain`` outside [0, 1] or a ``--policy`` nobody registered."""
+    if not 0.0 <= args.abstain <= 1.0:
+        raise GiftError(f"--abstain must be in [0, 1] (a distance to the cut), got {args.abstain}")
+    policies = get_manager().names("query_policy")
+    if args.policy not in policies:
+        raise GiftError(f"unknown query policy {args.policy!r}; registered: {', '.join(policies)}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="gift", description="Generalizing Intent for Flexible Test-time rewards",
                                      parents=[_verbosity_parser(False)])

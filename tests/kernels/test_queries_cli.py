@@ -75,7 +75,7 @@ def test_gift_align_asks_on_the_terminal_saves_the_answers_and_a_rerun_does_not_
 def test_gift_align_names_a_bad_policy_or_budget(tmp_path, capsys):
     args = ALIGN[3:] + ["--answers", str(tmp_path / "a.json")]
     assert main(args + ["--ask", "1", "--policy", "psychic"]) == 1
-    assert "no query_policy named 'psychic'" in capsys.readouterr().err
+    assert "unknown query policy 'psychic'; registered:" in capsys.readouterr().err
     assert main(args + ["--ask", "-1"]) == 1
     assert "--ask must be >= 0" in capsys.readouterr().err
     assert main(args + ["--abstain", "2"]) == 1

@@ -11,6 +11,7 @@ import sys
 import time
 from pathlib import Path
 
+from gift.cli import add_answer_arguments, check_answer_arguments
 from gift.core.errors import GiftError
 from gift.core.executor import add_executor_argument, executor_from_args
 from gift.plugins.hookspecs import hookimpl
@@ -55,30 +56,18 @@ def check_kernels(specs: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def add_query_arguments(p: argparse.ArgumentParser) -> None:
-    """``--queries N --policy NAME --abstain BAND``: questions the simulated human (the suite's labels) answers."""
+    """``--queries N`` and :func:`gift.cli.add_answer_arguments`: questions the simulated human (the suite's labels)
+    answers."""
     p.add_argument("--queries", type=int, default=0, metavar="N",
                    help="per intent and kernel, ask the simulated human (the suite's labels) N questions "
                         "'is this object part of the goal?' and re-score (default 0); adds a row per kernel")
-    p.add_argument("--policy", default="uncertainty", metavar="NAME",
-                   help="query policy choosing the questions: uncertainty (default), disagreement, error-bound, "
-                        "expected-error, random, or another registered one (gift plugins)")
-    p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
-                   help="flag instead of decide the objects whose decision score is within BAND of the cut; "
-                        "their features are dropped like a distractor's (default 0: never)")
-    p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
-                   help="a kernel that can use the answers scores the scene again after each answer (the default; "
-                        "gift-prob weighs them as evidence, no LM call, or with gift-prob:rescore_with=ladder names "
-                        "its ladder again); --no-rescore: answers only re-threshold the first scores")
+    add_answer_arguments(p)
 
 
 def _check_queries(args: argparse.Namespace) -> None:
     if args.queries < 0:
         raise GiftError(f"--queries must be >= 0, got {args.queries}")
-    if not 0.0 <= args.abstain <= 1.0:
-        raise GiftError(f"--abstain must be in [0, 1] (a distance to the cut), got {args.abstain}")
-    policies = _names("query_policy")
-    if args.policy not in policies:
-        raise GiftError(f"unknown query policy {args.policy!r}; registered: {', '.join(policies)}")
+    check_answer_arguments(args)
 
 
 def _configure_reproduce(p: argparse.ArgumentParser) -> None:

@@ -17,6 +17,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from gift.cli import add_answer_arguments, check_answer_arguments
 from gift.core import serialization
 from gift.core.alignment import THRESHOLDS, score_alignment
 from gift.core.data import DISTRACTOR, Intent, ObjectSpec
@@ -44,15 +45,7 @@ def configure_align(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ask", type=int, default=0, metavar="N",
                    help="ask on the terminal about up to N test objects (saved answers count; a rerun does not ask "
                         "again) and re-score with the answers")
-    p.add_argument("--policy", default="uncertainty", metavar="NAME",
-                   help="which objects to ask about: uncertainty (default), disagreement, error-bound, "
-                        "expected-error, random")
-    p.add_argument("--abstain", type=float, default=0.0, metavar="BAND",
-                   help="flag instead of decide the objects within BAND of the cut (dropped like a distractor)")
-    p.add_argument("--rescore", action=argparse.BooleanOptionalAction, default=True,
-                   help="a kernel that can use the answers scores the scene again after each answer (the default; "
-                        "gift-prob weighs them as evidence, no LM call); --no-rescore: answers only re-threshold "
-                        "the first scores")
+    add_answer_arguments(p)
     p.add_argument("--answers", default=None, metavar="FILE",
                    help="where --ask saves and finds answers (default: answers.json in the gift cache directory)")
 
@@ -123,8 +116,7 @@ def run_align(args: argparse.Namespace) -> int:
                         "train-calibrated or a number")
     if args.ask < 0:
         raise GiftError(f"--ask must be >= 0, got {args.ask}")
-    if not 0.0 <= args.abstain <= 1.0:
-        raise GiftError(f"--abstain must be in [0, 1] (a distance to the cut), got {args.abstain}")
+    check_answer_arguments(args)
     threshold: str | float = args.threshold or ("train-calibrated" if args.ask else "non-oracle")
     if threshold not in THRESHOLDS:
         try:
