@@ -77,6 +77,8 @@ DEV31_LABEL = {"raspberries": "ε1a", "penguin_shaped_things": "ε1b", "pancakes
                "kendo_kit": "ε3a", "pandemic_kit": "ε3b", "geodes": "ε4a", "peanut_things": "ε4b"}
 DEV32_LABEL = {"dates": "ζ1a", "cat_shaped_things": "ζ1b", "dumplings": "ζ2a", "sheepskin_things": "ζ2b",
                "boxing_kit": "ζ3a", "wingspan_kit": "ζ3b", "crystals": "ζ4a", "hazelnut_things": "ζ4b"}
+DEV33_LABEL = {"durians": "η1a", "turtle_shaped_things": "η1b", "prawns": "η2a", "tulle_things": "η2b",
+               "scuba_kit": "η3a", "terraforming_mars_kit": "η3b", "amber": "η4a", "buckwheat_things": "η4b"}
 
 
 def summary(suite, label: dict[str, str], column: str) -> str:
@@ -134,7 +136,7 @@ DEV_SUITE_LABELS = {"gift-dev": DEV_LABEL, "gift-dev2": DEV2_LABEL, "gift-dev3":
                     "gift-dev23": DEV23_LABEL, "gift-dev24": DEV24_LABEL, "gift-dev25": DEV25_LABEL,
                     "gift-dev26": DEV26_LABEL, "gift-dev27": DEV27_LABEL,
                     "gift-dev28": DEV28_LABEL, "gift-dev29": DEV29_LABEL, "gift-dev30": DEV30_LABEL,
-                    "gift-dev31": DEV31_LABEL, "gift-dev32": DEV32_LABEL}
+                    "gift-dev31": DEV31_LABEL, "gift-dev32": DEV32_LABEL, "gift-dev33": DEV33_LABEL}
 
 
 def main() -> None:
