@@ -2,8 +2,8 @@
 ``gift-dev6``, ``gift-dev7``, ``gift-dev8``, ``gift-dev9``, ``gift-dev10``, ``gift-dev11``, ``gift-dev12``,
 ``gift-dev13``, ``gift-dev14``, ``gift-dev15``, ``gift-dev16``, ``gift-dev17``, ``gift-dev18``, ``gift-dev19``,
 ``gift-dev20``, ``gift-dev21``, ``gift-dev22``, ``gift-dev23``, ``gift-dev24``, ``gift-dev25``, ``gift-dev26``,
-``gift-dev27``, ``gift-dev28``, ``gift-dev29``, ``gift-dev30``, ``gift-dev31`` and ``gift-dev32``: new intents and
-objects, none borrowed from the suites they are checked against.
+``gift-dev27``, ``gift-dev28``, ``gift-dev29``, ``gift-dev30``, ``gift-dev31``, ``gift-dev32`` and ``gift-dev33``: new
+intents and objects, none borrowed from the suites they are checked against.
 
 Like ``test_gift_paper_suite.py`` these check the data (catalog, splits, subsets, look-alikes, the
 document's tables); they also check by name that nothing is shared with ``gift-paper``, the LM test
@@ -428,6 +428,20 @@ DEV_SUITES = {
                        r"|desert roses?|calcite|celestite|swarovski"
                        r"|hazel|filbert|\bcobnuts?\b|\bcobs?\b|corylus|nocciol|gianduj|frangelico|nutella|avellan"
                        r"|noisette|tonda gentile|giffoni|kentish|f[iı]nd[iı]k",
+    },
+    "gift-dev33": {
+        "siblings": [("durians", "turtle_shaped_things"), ("prawns", "tulle_things"),
+                     ("scuba_kit", "terraforming_mars_kit"), ("amber", "buckwheat_things")],
+        "label_words": r"durian|musang|monthong|black ?thorn|tempoyak|\bdurio\b"
+                       r"|turtle|tortois|terrapin|squirtle|wartortle|blastoise|koopa|bowser|gamera|\bcheloni|testudo"
+                       r"|prawn|shrimp|\bgambas?\b|carabinero|\bebi\b|langoustin|scampi|crevette|camar[oó]n|vannamei"
+                       r"|penaeus|tulle|\btutus?\b|petticoat|bobbinet|crinoline"
+                       r"|scuba|\bdiv(?:e|es|er|ers|ing)\b|aqualung|\bpadi\b|suunto|\bd?smb\b|regulator|snorkel|wetsuit"
+                       r"|buoyancy|\bbcd\b|apeks|scubapro"
+                       r"|terraform|\bmars\b|martian|red planet|fryxgames|\bprelude\b|venus next|hellas|elysium|tharsis"
+                       r"|ares expedition"
+                       r"|\bamber|burmite|succinite|rumanite|simetite|gedanite|bernstein|bursztyn"
+                       r"|buckwheat|fagopyrum|\bsoba\b|sobacha|kasha|pizzoccher|grechk|galettes?\b|\bblini|kuqiao",
     },
 }
 DOC = ROOT / "docs" / "suites.md"
