@@ -71,6 +71,7 @@ ROLES: dict[str, str] = {
     "gift-dev29": "blind; reported only",
     "gift-dev30": "blind; reported only",
     "gift-dev31": "blind; reported only",
+    "gift-dev32": "blind; reported only",
 }
 
 
@@ -169,6 +170,8 @@ RUNS: tuple[Run, ...] = (
     Run("gift-dev30", "ground-truth", F + "gift-dev30-ground-truth.json"),
     Run("gift-dev31", "inferred", F + "gift-dev31-inferred.json"),
     Run("gift-dev31", "ground-truth", F + "gift-dev31-ground-truth.json"),
+    Run("gift-dev32", "inferred", F + "gift-dev32-inferred.json"),
+    Run("gift-dev32", "ground-truth", F + "gift-dev32-ground-truth.json"),
 )
 
 
