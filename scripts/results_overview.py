@@ -102,8 +102,8 @@ OLD7 = 'the default before this suite\'s decision: `embed_text="name"`; before `
 RUNS: tuple[Run, ...] = (
     Run("gift-paper", "inferred", F + "gift-paper-prototype-inferred.json"),
     Run("gift-paper", "ground-truth", F + "gift-paper-prototype-ground-truth.json"),
-    Run("lm-dev", "inferred", F + "check-margin-lm-dev-inferred.json", baselines=F + "decision-lm-dev-inferred.json"),
-    Run("lm-dev", "ground-truth", F + "ladder-boundary-lm-dev-ground-truth.json", note=OLD),
+    Run("lm-dev", "inferred", F + "lm-dev-prototype-inferred.json"),
+    Run("lm-dev", "ground-truth", F + "lm-dev-prototype-ground-truth.json"),
     Run("gift-dev", "inferred", F + "gift-dev-default-inferred.json"),
     Run("gift-dev", "ground-truth", F + "gift-dev-default-ground-truth.json"),
     Run("gift-dev2", "inferred", F + "decision-gift-dev2-inferred.json", kernel="gift-prob:check=fit", note=OLD),
